@@ -1,0 +1,39 @@
+# SPDX-License-Identifier: MIT
+# Every dependency comes from Debian 12's packages (scripts/setup installs them); the quirks
+# worked around here are described in docs/building.md.
+
+find_package(Threads REQUIRED)
+find_package(PkgConfig REQUIRED)
+find_package(embree 3 CONFIG REQUIRED)
+find_package(TBB CONFIG REQUIRED)
+find_package(yaml-cpp CONFIG REQUIRED)
+find_package(tinyobjloader CONFIG REQUIRED)  # no version: Debian's reports "2rc10"
+find_package(CLI11 CONFIG REQUIRED)
+find_package(fmt CONFIG REQUIRED)
+find_package(nlohmann_json CONFIG REQUIRED)
+find_package(OpenImageIO CONFIG REQUIRED)
+
+# Quirk A: Debian built OpenImageIO with OpenCV, and its exported target names
+# /usr/include/opencv4, which does not exist unless libopencv-dev (+417 MB) is installed.
+foreach(property INTERFACE_INCLUDE_DIRECTORIES INTERFACE_SYSTEM_INCLUDE_DIRECTORIES)
+  get_target_property(dirs OpenImageIO::OpenImageIO ${property})
+  if(dirs)
+    set(kept "")
+    foreach(dir IN LISTS dirs)
+      if(EXISTS "${dir}" OR dir MATCHES "^\\$<")
+        list(APPEND kept "${dir}")
+      endif()
+    endforeach()
+    set_target_properties(OpenImageIO::OpenImageIO PROPERTIES ${property} "${kept}")
+  endif()
+endforeach()
+
+# Quirk B: OpenColorIO's CMake config computes a wrong prefix on Debian; pkg-config is right.
+pkg_check_modules(OCIO REQUIRED IMPORTED_TARGET OpenColorIO>=2.1)
+
+if(WHITTED_BUILD_TESTS)
+  find_package(GTest CONFIG REQUIRED)
+endif()
+if(WHITTED_BUILD_BENCHMARKS)
+  find_package(benchmark CONFIG REQUIRED)
+endif()

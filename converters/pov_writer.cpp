@@ -1,0 +1,339 @@
+// SPDX-License-Identifier: MIT
+// Scene format v1 → POV-Ray 3.7 SDL, following pov-model.md: a right-handed camera through
+// `right -x·W/H`, lights without falloff, `parallel` lights at Whitted's directional distance,
+// max_trace_level = max_depth with adc_bailout 0, and the lecture's material either as one
+// texture (recipe A, where exact) or as four layers (recipe B, exact for any RGB ka, kd, ks).
+//
+// Nothing from the scene file is ever written as SDL text except numbers: names become
+// comments only after every character outside a small safe set is replaced.
+
+#include "converters/pov_writer.h"
+
+#include "whitted/core/ray.h"
+#include "whitted/scene/mesh_file.h"
+#include "whitted/scene/scene.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+
+namespace whitted::pov {
+namespace {
+
+/// The shortest decimal that reads back as the same double (fmt uses Dragonbox): POV-Ray
+/// parses it to exactly the value Whitted uses.
+std::string num(double v) {
+    if (v == 0) return "0";  // also turns −0 into 0
+    return fmt::format("{}", v);
+}
+std::string vec(const Vec3& v) {
+    return "<" + num(v.x) + ", " + num(v.y) + ", " + num(v.z) + ">";
+}
+std::string rgb(const Color& c) {
+    return "rgb " + vec(c);
+}
+
+/// Text from the scene placed in an SDL comment: only characters that cannot end the comment
+/// or start a directive survive.
+std::string comment_safe(const std::string& text) {
+    std::string out;
+    for (const unsigned char c : text.substr(0, 200))
+        out += (std::isalnum(c) || c == '_' || c == '-' || c == '.' || c == '/' || c == ' ') ? char(c) : '_';
+    return out;
+}
+
+bool is_grey(const Color& c) {
+    return c.x == c.y && c.y == c.z;
+}
+
+/// The highlight statement for a finish: Blinn-Phong is `specular s roughness 1/p`, Phong is
+/// `phong s phong_size p` (pov-model.md §2).
+std::string highlight(Highlight kind, double strength, double p) {
+    if (strength == 0) return "specular 0 phong 0";
+    if (kind == Highlight::phong) return "specular 0 phong " + num(strength) + " phong_size " + num(p);
+    return "phong 0 specular " + num(strength) + " roughness " + num(1.0 / p);
+}
+
+std::string mirror(const Color& km) {
+    return is_zero(km) ? "" : " reflection { " + rgb(km) + " }";
+}
+
+/// The lecture's material as POV-Ray texture(s).
+std::string texture(const Material& m) {
+    // Recipe A (pov-model.md §1a): one texture. POV multiplies ambient and diffuse by the
+    // pigment, not the highlight, so it is exact when ks is grey and kd_c > 0 wherever ka_c > 0.
+    bool single_texture_exact = is_grey(m.ks);
+    for (int c = 0; c < 3; ++c) single_texture_exact &= !(m.ka[c] > 0 && m.kd[c] == 0);
+    if (single_texture_exact) {
+        if (is_zero(m.kd)) {
+            return "texture { pigment { rgb 1 } finish { ambient " + rgb(m.ka) + " diffuse 0 brilliance 1 " +
+                   highlight(m.highlight, m.ks.x, m.p) + mirror(m.km) + " } }";
+        }
+        Color ambient_ratio;
+        for (int c = 0; c < 3; ++c) ambient_ratio[c] = m.kd[c] > 0 ? m.ka[c] / m.kd[c] : 0.0;
+        return "texture { pigment { " + rgb(m.kd) + " } finish { ambient " + rgb(ambient_ratio) +
+               " diffuse 1 brilliance 1 " + highlight(m.highlight, m.ks.x, m.p) + mirror(m.km) + " } }";
+    }
+    // Recipe B (pov-model.md §1b): four layers, bottom first, with t1 = t2 = 1/2 and s = 1:
+    //   L4 opaque black, holds the highlight lobe (never tinted by its own pigment);
+    //   L3 a pure filter ks/(t1·t2) that tints L4's highlight to exactly ks;
+    //   L2 kd/(t1·(1 − t2)) at transmit t2: the diffuse term;
+    //   L1 white at transmit t1 with ambient ka/(1 − t1) and the mirror (reflection is not filtered).
+    // Requires adc_bailout 0 (written in global_settings).
+    constexpr double t1 = 0.5, t2 = 0.5;
+    return "texture { pigment { rgb 0 } finish { ambient 0 diffuse 0 " + highlight(m.highlight, 1.0, m.p) +
+           " } }\n    texture { pigment { rgbf <" + num(m.ks.x / (t1 * t2)) + ", " + num(m.ks.y / (t1 * t2)) + ", " +
+           num(m.ks.z / (t1 * t2)) + ", 1> } finish { ambient 0 diffuse 0 specular 0 phong 0 } }\n" +
+           "    texture { pigment { rgbt <" + num(m.kd.x / (t1 * (1 - t2))) + ", " + num(m.kd.y / (t1 * (1 - t2))) +
+           ", " + num(m.kd.z / (t1 * (1 - t2))) + ", " + num(t2) +
+           "> } finish { ambient 0 diffuse 1 brilliance 1 specular 0 phong 0 } }\n" +
+           "    texture { pigment { rgbt <1, 1, 1, " + num(t1) + "> } finish { ambient " + rgb(m.ka / (1 - t1)) +
+           " diffuse 0 specular 0 phong 0" + mirror(m.km) + " } }";
+}
+
+/// POV-Ray multiplies row vectors by its matrix: its rows are our columns, then the translation.
+std::string matrix(const Transform& t) {
+    if (t.is_identity()) return "";
+    const auto& m = t.rows();
+    return " matrix <" + num(m[0]) + ", " + num(m[4]) + ", " + num(m[8]) + ", " + num(m[1]) + ", " + num(m[5]) + ", " +
+           num(m[9]) + ", " + num(m[2]) + ", " + num(m[6]) + ", " + num(m[10]) + ", " + num(m[3]) + ", " + num(m[7]) +
+           ", " + num(m[11]) + ">";
+}
+
+/// Walks the description as validate_scene does (same transforms, same materials), writing SDL.
+class SdlWriter {
+public:
+    SdlWriter(const SceneDescription& description, std::string& out) : m_description(description), m_out(out) {
+        for (const auto& material : description.materials) m_named[material.name] = to_material(material);
+    }
+
+    void objects(const std::vector<ObjectDescription>& list, const Transform& parent) {
+        for (const auto& object : list) write(object, parent);
+    }
+
+private:
+    static Material to_material(const MaterialDescription& d) {
+        return {d.ka.value, d.kd.value, d.ks.value, d.p.value, d.km.value, d.highlight.value};
+    }
+
+    Material material_of(const ObjectDescription& object) const {
+        const MaterialReference& reference = *object.material;  // validate_scene has checked it is there
+        if (reference.inline_) return to_material(*reference.inline_);
+        return m_named.at(reference.name);
+    }
+
+    void write(const ObjectDescription& object, const Transform& parent) {
+        const Transform to_world = make_transform(object.transform).then(parent);
+        switch (object.type) {
+            case ObjectType::sphere:
+                m_out += "sphere { " + vec(object.center.value) + ", " + num(object.radius.value) + "\n    " +
+                         texture(material_of(object)) + "\n   " + matrix(to_world) + " }\n";
+                break;
+            case ObjectType::box:
+                m_out += "box { " + vec(object.min.value) + ", " + vec(object.max.value) + "\n    " +
+                         texture(material_of(object)) + "\n   " + matrix(to_world) + " }\n";
+                break;
+            case ObjectType::plane: {
+                // World-space plane computed exactly as Whitted does; POV's `plane { n, d }` is n·x = d.
+                const Vec3 normal = normalize(to_world.apply_normal(object.normal.value));
+                const Vec3 point = to_world.apply_point(object.point.value);
+                m_out += "plane { " + vec(normal) + ", " + num(dot(normal, point)) + "\n    " +
+                         texture(material_of(object)) + " }\n";
+                break;
+            }
+            case ObjectType::triangle:
+                mesh(object.vertices, {}, {{0, 1, 2}}, to_world, material_of(object));
+                break;
+            case ObjectType::mesh:
+                if (object.file.given)
+                    mesh_file(object, to_world);
+                else
+                    mesh(object.vertices, object.normals, object.triangles, to_world, material_of(object));
+                break;
+            case ObjectType::group:
+                objects(object.children, to_world);
+                break;
+        }
+    }
+
+    void mesh_file(const ObjectDescription& object, const Transform& to_world) {
+        const MeshData data = load_obj_mesh(object.file_path, object.file.where);
+        std::vector<Vec3> vertices, normals;
+        for (size_t i = 0; i < data.positions.size() / 3; ++i)
+            vertices.push_back({data.positions[3 * i], data.positions[3 * i + 1], data.positions[3 * i + 2]});
+        for (size_t i = 0; i < data.normals.size() / 3; ++i)
+            normals.push_back({data.normals[3 * i], data.normals[3 * i + 1], data.normals[3 * i + 2]});
+        // One mesh2 per material: the MTL's, or the scene's override for all faces.
+        std::map<int32_t, std::vector<std::array<int64_t, 3>>> by_material;
+        for (size_t t = 0; t < data.indices.size() / 3; ++t) {
+            const int32_t m = object.material ? -1 : data.triangle_material[t];
+            by_material[m].push_back({data.indices[3 * t], data.indices[3 * t + 1], data.indices[3 * t + 2]});
+        }
+        for (const auto& [m, triangles] : by_material) {
+            const MaterialDescription* mtl = m >= 0 ? &data.materials[size_t(m)] : nullptr;
+            mesh(vertices, normals, triangles, to_world, mtl ? to_material(*mtl) : material_of(object));
+        }
+    }
+
+    /// A mesh2 in world space: vertices and normals transformed in double exactly as Whitted
+    /// does before both store them as float, so the two renderers see the same triangles.
+    void mesh(const std::vector<Vec3>& vertices, const std::vector<Vec3>& normals,
+              const std::vector<std::array<int64_t, 3>>& triangles, const Transform& to_world,
+              const Material& material) {
+        std::string& o = m_out;
+        o += "mesh2 {\n  vertex_vectors { " + std::to_string(vertices.size());
+        for (const Vec3& v : vertices) {
+            const Vec3 w = to_world.apply_point(v);
+            o += ",\n    " + vec({float(w.x), float(w.y), float(w.z)});
+        }
+        o += " }\n";
+        if (!normals.empty()) {
+            o += "  normal_vectors { " + std::to_string(normals.size());
+            for (const Vec3& n : normals) {
+                const Vec3 w = to_world.apply_normal(n);
+                const double len = length(w);
+                const Vec3 unit = len > 0 ? w / len : Vec3(1, 0, 0);
+                o += ",\n    " + vec({float(unit.x), float(unit.y), float(unit.z)});
+            }
+            o += " }\n";
+        }
+        o += "  face_indices { " + std::to_string(triangles.size());
+        for (const auto& t : triangles)
+            o += ",\n    <" + std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " + std::to_string(t[2]) + ">";
+        o += " }\n  " + texture(material) + "\n}\n";
+    }
+
+    const SceneDescription& m_description;
+    std::string& m_out;
+    std::map<std::string, Material> m_named;
+};
+
+double max_channel(const Color& c) {
+    return std::max({c.x, c.y, c.z});
+}
+
+}  // namespace
+
+double radiance_upper_bound(const SceneDescription& d) {
+    Color light_sum(0.0);
+    for (const auto& light : d.lights) light_sum += light.intensity.value;
+    std::vector<MaterialDescription> materials = d.materials;
+    std::function<void(const std::vector<ObjectDescription>&)> collect = [&](const auto& objects) {
+        for (const auto& object : objects) {
+            if (object.material && object.material->inline_) materials.push_back(*object.material->inline_);
+            collect(object.children);
+        }
+    };
+    collect(d.objects);
+    double local = 0, mirror = 0;
+    for (const auto& m : materials) {
+        local = std::max(local, max_channel(m.ka.value * d.ambient.value + (m.kd.value + m.ks.value) * light_sum));
+        mirror = std::max(mirror, max_channel(m.km.value));
+    }
+    // Meshes from files bring their own MTL materials; without reading them, assume the worst.
+    std::function<bool(const std::vector<ObjectDescription>&)> has_mtl = [&](const auto& objects) {
+        for (const auto& object : objects)
+            if ((object.type == ObjectType::mesh && object.file.given && !object.material) || has_mtl(object.children))
+                return true;
+        return false;
+    };
+    if (has_mtl(d.objects)) return INFINITY;
+    const double background = max_channel(d.image.background.value);
+    double bound = std::max(background, local);
+    for (int64_t depth = 2; depth <= d.max_depth.value; ++depth) bound = std::max(background, local + mirror * bound);
+    return bound;
+}
+
+std::string scene_to_sdl(const SceneDescription& d, const ConvertOptions& options) {
+    const double exposure = options.exposure;
+    const double aspect = double(d.image.width.value) / double(d.image.height.value);
+    std::string o;
+    o += "// POV-Ray 3.7 scene written by `whitted convert` from " + comment_safe(d.path) + " (scene format v1).\n";
+    o += "// Render it with the .ini beside it (deterministic, linear); see docs/validation.md.\n";
+    o += "#version 3.7;\n";
+    o += "global_settings {\n  assumed_gamma 1.0\n  ambient_light " + rgb(d.ambient.value * exposure) +
+         "\n  max_trace_level " + std::to_string(d.max_depth.value) + "\n  adc_bailout 0\n}\n";
+    o += "background { " + rgb(d.image.background.value * exposure) + " }\n";
+
+    const CameraDescription& c = d.camera;
+    if (c.type.value == CameraType::perspective) {
+        // `right -x·W/H` makes POV-Ray's camera right-handed (pov-model.md §4); `angle` is the horizontal fov.
+        o += "camera {\n  perspective\n  location " + vec(c.eye.value) + "\n  right <" + num(-aspect) +
+             ", 0, 0>\n  up <0, 1, 0>\n  sky " + vec(c.up.value) + "\n  angle " + num(c.fov.value) + "\n  look_at " +
+             vec(c.look_at.value) + "\n}\n";
+    } else {
+        // Explicit right/up and no angle: their lengths are the view's extent in world units.
+        o += "camera {\n  orthographic\n  location " + vec(c.eye.value) + "\n  right <" + num(-c.view_width.value) +
+             ", 0, 0>\n  up <0, " + num(c.view_width.value / aspect) + ", 0>\n  sky " + vec(c.up.value) +
+             "\n  look_at " + vec(c.look_at.value) + "\n}\n";
+    }
+
+    for (const auto& light : d.lights) {
+        const Color intensity = light.intensity.value * exposure;
+        if (light.type == LightType::point) {
+            o += "light_source { " + vec(light.position.value) + " color " + rgb(intensity) + " }\n";
+        } else {
+            // A parallel light aimed at the origin from directional_light_distance away: POV-Ray
+            // then limits shadow rays exactly as Whitted does (ray.h).
+            const Vec3 toward_light = -normalize(light.direction.value);
+            o += "light_source { " + vec(toward_light * ray_limits::directional_light_distance) + " color " +
+                 rgb(intensity) + " parallel point_at <0, 0, 0> }\n";
+        }
+    }
+    SdlWriter writer(d, o);
+    writer.objects(d.objects, Transform());
+    return o;
+}
+
+std::string ini_for(const SceneDescription& d, const std::string& pov_file, const std::string& image_file,
+                    const ConvertOptions& options) {
+    for (const std::string* name : {&pov_file, &image_file})
+        if (name->find_first_of("\"\n\r;") != std::string::npos)
+            throw std::invalid_argument("file name '" + comment_safe(*name) +
+                                        "' contains characters a POV-Ray .ini cannot hold (quote, newline, ';')");
+    const int64_t n = d.image.samples.value;
+    std::string o;
+    o += "; POV-Ray 3.7 options written by `whitted convert`: deterministic, linear output.\n";
+    if (n > 1)
+        o += "; image.samples = " + std::to_string(n) + ": rendered at " + std::to_string(n) +
+             "x the size; average each " + std::to_string(n) + "x" + std::to_string(n) +
+             " block for Whitted's box filter.\n";
+    o += "Input_File_Name=\"" + pov_file + "\"\n";
+    o += "Output_File_Name=\"" + image_file + "\"\n";
+    o += "+W" + std::to_string(d.image.width.value * n) + " +H" + std::to_string(d.image.height.value * n) +
+         " -D -A +Q9\n";
+    o += options.hdr_output ? "+FE\n" : "+FN16\nFile_Gamma=1.0\n";
+    return o;
+}
+
+std::string write_pov_files(const SceneDescription& d, const std::string& pov_path, const ConvertOptions& given) {
+    ConvertOptions options = given;
+    if (!given.hdr_output && radiance_upper_bound(d) * options.exposure > 1.0) options.hdr_output = true;
+    const std::filesystem::path pov(pov_path);
+    std::filesystem::path ini = pov;
+    ini.replace_extension(".ini");
+    std::filesystem::path image = pov.filename();
+    image.replace_extension(options.hdr_output ? ".exr" : ".png");
+    const std::string sdl = scene_to_sdl(d, options);
+    const std::string ini_text = ini_for(d, pov.filename().string(), image.string(), options);
+    for (const auto& [path, text] : {std::pair{pov, &sdl}, std::pair{ini, &ini_text}}) {
+        const std::filesystem::path temporary = path.string() + ".tmp";
+        {
+            std::ofstream out(temporary, std::ios::binary);
+            out << *text;
+            if (!out) {
+                std::filesystem::remove(temporary);
+                throw std::runtime_error("cannot write '" + path.string() + "'");
+            }
+        }
+        std::filesystem::rename(temporary, path);
+    }
+    return ini.string();
+}
+
+}  // namespace whitted::pov

@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// Scene format v1 → POV-Ray 3.7 SDL that renders the same image (pov-model.md). Reads the
+// plain SceneDescription, never the render objects, like any other consumer of the format.
+
+#include "whitted/scene/description.h"
+
+#include <string>
+
+namespace whitted::pov {
+
+struct ConvertOptions {
+    /// Multiplies every light, the ambient light and the background (the image is linear in
+    /// them, and a power of two keeps it exact). `whitted check` uses it to bring scenes whose
+    /// values exceed 1 into a 16-bit PNG's range.
+    double exposure = 1.0;
+    /// Output image type written into the .ini: false = 16-bit linear PNG (+FN16
+    /// File_Gamma=1.0, clips at 1), true = OpenEXR (+FE, half floats, unclipped).
+    bool hdr_output = false;
+};
+
+/// The whole SDL scene.
+std::string scene_to_sdl(const SceneDescription& scene, const ConvertOptions& options = {});
+
+/// The .ini that renders it deterministically and linearly: +W +H -D -A +FN16 File_Gamma=1.0
+/// (or +FE). With image.samples = n > 1 the render is n·W × n·H, one sample per pixel on
+/// exactly Whitted's n×n grid; averaging n×n blocks gives Whitted's box filter.
+std::string ini_for(const SceneDescription& scene, const std::string& pov_file, const std::string& image_file,
+                    const ConvertOptions& options = {});
+
+/// An upper bound of any pixel value of the scene (ambient + all lights at full strength,
+/// mirrors summed over max_depth, background): at most 1 means a PNG cannot clip it.
+double radiance_upper_bound(const SceneDescription& scene);
+
+/// Writes `pov_path` and the .ini beside it (same name, .ini). Returns the .ini path.
+/// Throws InputError for anything the description cannot express (mesh files are read here).
+std::string write_pov_files(const SceneDescription& scene, const std::string& pov_path,
+                            const ConvertOptions& options = {});
+
+}  // namespace whitted::pov

@@ -1,0 +1,257 @@
+// SPDX-License-Identifier: MIT
+// The `whitted` program: render, convert and check scene files. Thin: each command calls the
+// libraries and turns their exceptions into messages and exit codes
+// (0 ok, 1 failure while rendering or checking, 2 bad input or usage, 130/143 interrupted).
+
+#include "converters/pov_writer.h"
+#include "reference/check.h"
+#include "whitted/output/image_output.h"
+#include "whitted/render/accelerator.h"
+#include "whitted/render/renderer.h"
+#include "whitted/scene/description.h"
+#include "whitted/scene/scene.h"
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <thread>
+
+namespace {
+
+using namespace whitted;
+
+constexpr int exit_ok = 0, exit_failure = 1, exit_bad_input = 2;
+
+std::atomic<bool> g_cancel{false};
+std::atomic<int> g_signal{0};
+
+extern "C" void on_signal(int signal) {
+    g_signal.store(signal);
+    g_cancel.store(true);
+}
+
+void install_signal_handlers() {
+    struct sigaction action {};
+    action.sa_handler = on_signal;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, nullptr);
+    sigaction(SIGTERM, &action, nullptr);
+}
+
+void print_error(const std::string& message) {
+    std::fprintf(stderr, "whitted: error: %s\n", message.c_str());
+}
+
+std::string format_duration(double seconds) {
+    if (seconds < 60) return fmt::format("{:.1f}s", seconds);
+    return fmt::format("{}m{:02d}s", int(seconds / 60), int(seconds) % 60);
+}
+
+void draw_progress(const RenderProgress& p) {
+    const double fraction = p.tiles_total ? double(p.tiles_done) / double(p.tiles_total) : 1.0;
+    constexpr int width = 30;
+    const int filled = int(fraction * width);
+    std::string bar(filled, '=');
+    if (filled < width) bar += '>' + std::string(width - filled - 1, ' ');
+    const double rate = p.seconds > 0 ? double(p.rays) / p.seconds / 1e6 : 0.0;
+    const double eta = fraction > 0 ? p.seconds * (1 - fraction) / fraction : 0.0;
+    std::fprintf(stderr, "\r[%s] %5.1f%%  %7.2f M rays/s  elapsed %s  ETA %s   ", bar.c_str(), 100 * fraction, rate,
+                 format_duration(p.seconds).c_str(), fraction > 0 ? format_duration(eta).c_str() : "?");
+    std::fflush(stderr);
+}
+
+struct RenderArguments {
+    std::string scene, output = "whitted.png";
+    int threads = 0;
+    bool quiet = false, half = false, partial = false;
+    int bit_depth = 0;
+    std::string ocio_config, display, view;
+};
+
+int run_render(const RenderArguments& args) {
+    const auto start = std::chrono::steady_clock::now();
+    Scene scene;
+    try {
+        check_output_path(args.output);
+        scene = validate_scene(parse_scene_file(args.scene));
+    } catch (const InputError& e) {
+        print_error(e.what());
+        return exit_bad_input;
+    } catch (const std::invalid_argument& e) {
+        print_error(e.what());
+        return exit_bad_input;
+    }
+
+    try {
+        install_signal_handlers();
+        const Accelerator accelerator(scene);
+        RenderOptions options;
+        options.threads = args.threads;
+        options.cancel = &g_cancel;
+        if (!args.quiet && ::isatty(STDERR_FILENO)) options.on_progress = draw_progress;
+        RenderResult result = render(scene, accelerator, options);
+        if (options.on_progress) std::fputc('\n', stderr);
+
+        OutputOptions output;
+        output.half = args.half;
+        output.bit_depth = args.bit_depth;
+        output.ocio_config = args.ocio_config;
+        output.display = args.display;
+        output.view = args.view;
+        output.metadata = {{"whitted:scene", std::filesystem::absolute(args.scene).string()},
+                           {"whitted:render_seconds", fmt::format("{:.3f}", result.seconds)},
+                           {"whitted:rays", std::to_string(result.rays.total())}};
+        if (result.cancelled) {
+            const int signal = g_signal.load();
+            if (args.partial) {
+                output.metadata.push_back({"whitted:partial", "true: interrupted; unfinished tiles are black"});
+                write_image(result.image, args.output, output);
+                std::fprintf(stderr, "whitted: interrupted; partial image (unfinished tiles black) written to %s\n",
+                             args.output.c_str());
+            } else {
+                std::fprintf(stderr, "whitted: interrupted; nothing written (%s left as it was)\n",
+                             args.output.c_str());
+            }
+            return 128 + (signal ? signal : SIGINT);
+        }
+        write_image(result.image, args.output, output);
+        const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (!args.quiet)
+            std::fprintf(stderr,
+                         "whitted: %dx%d, %d sample(s)/pixel, %u thread(s): render %.3fs (total %.3fs), %.2f M rays "
+                         "(camera %.2f, shadow %.2f, reflected %.2f), %.1f M rays/s -> %s\n",
+                         scene.width, scene.height, scene.samples * scene.samples,
+                         args.threads > 0 ? unsigned(args.threads) : std::thread::hardware_concurrency(),
+                         result.seconds, total, result.rays.total() / 1e6, result.rays.camera / 1e6,
+                         result.rays.shadow / 1e6, result.rays.reflected / 1e6,
+                         result.seconds > 0 ? result.rays.total() / result.seconds / 1e6 : 0.0, args.output.c_str());
+        return exit_ok;
+    } catch (const std::invalid_argument& e) {
+        print_error(e.what());
+        return exit_bad_input;
+    } catch (const std::bad_alloc&) {
+        print_error("out of memory while rendering " + args.scene);
+        return exit_failure;
+    } catch (const std::exception& e) {
+        print_error(e.what());
+        return exit_failure;
+    }
+}
+
+int run_convert(const std::string& scene_path, const std::string& output) {
+    try {
+        const std::string ext = std::filesystem::path(output).extension().string();
+        if (ext != ".pov")
+            throw std::invalid_argument("cannot convert to '" + output + "': unknown format '" + ext +
+                                        "'; supported: .pov (POV-Ray 3.7)");
+        const SceneDescription description = parse_scene_file(scene_path);
+        validate_scene(description);  // refuse what Whitted itself would refuse
+        const std::string ini = pov::write_pov_files(description, output);
+        std::fprintf(stderr, "whitted: wrote %s and %s\n", output.c_str(), ini.c_str());
+        return exit_ok;
+    } catch (const InputError& e) {
+        print_error(e.what());
+        return exit_bad_input;
+    } catch (const std::invalid_argument& e) {
+        print_error(e.what());
+        return exit_bad_input;
+    } catch (const std::exception& e) {
+        print_error(e.what());
+        return exit_failure;
+    }
+}
+
+int run_check_command(const std::string& scene_path, const reference::CheckOptions& options) {
+    try {
+        const reference::CheckResult result = reference::run_check(scene_path, options);
+        return result.passed ? exit_ok : exit_failure;
+    } catch (const InputError& e) {
+        print_error(e.what());
+        return exit_bad_input;
+    } catch (const std::exception& e) {
+        print_error(e.what());
+        return exit_bad_input;  // POV-Ray missing or failing, unwritable report: cannot check
+    }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{
+        "Whitted: an offline ray tracer for the classic lecture shading model\n"
+        "  L = ka*Ia + sum_i [kd*I_i*max(0,n.l_i) + ks*I_i*max(0,n.h_i)^p] + km*L(r)\n"
+        "checked pixel by pixel against POV-Ray 3.7.",
+        "whitted"};
+    app.set_version_flag("--version", std::string("whitted ") + "0.1.0");
+    app.require_subcommand(1);
+    app.footer(
+        "Exit status: 0 success; 1 failure while rendering or checking (or images disagree);\n"
+        "2 bad input or usage; 130/143 interrupted by SIGINT/SIGTERM.\n"
+        "Scene format: docs/scene-format.md. Examples: examples/lecture/.");
+
+    RenderArguments render_args;
+    CLI::App* render_cmd = app.add_subcommand("render", "Render a scene file (YAML or JSON, format v1) to an image");
+    render_cmd->add_option("scene", render_args.scene, "Scene file")->required()->check(CLI::ExistingFile);
+    render_cmd
+        ->add_option("-o,--output", render_args.output,
+                     "Output image: .exr is linear float (scene-referred); .png/.jpg/.tif go through the "
+                     "OpenColorIO display transform")
+        ->capture_default_str();
+    render_cmd->add_option("-t,--threads", render_args.threads, "Worker threads (default: all cores)")
+        ->check(CLI::Range(0, 4096));
+    render_cmd->add_flag("-q,--quiet", render_args.quiet, "No progress bar and no summary line");
+    render_cmd->add_flag("--half", render_args.half, "EXR: write half floats instead of 32-bit floats");
+    render_cmd->add_option("--bit-depth", render_args.bit_depth, "PNG/TIFF bits per channel (8 or 16)")
+        ->check(CLI::IsMember({8, 16}));
+    render_cmd->add_option("--ocio-config", render_args.ocio_config,
+                           "OpenColorIO config file (default: $OCIO, else the built-in sRGB config)");
+    render_cmd->add_option("--display", render_args.display, "OCIO display (default: the config's default)");
+    render_cmd->add_option("--view", render_args.view, "OCIO view (default: the display's default)");
+    render_cmd->add_flag("--partial", render_args.partial,
+                         "If interrupted, still write what was finished (marked partial in the metadata)");
+
+    std::string convert_scene, convert_output;
+    CLI::App* convert_cmd = app.add_subcommand("convert", "Convert a scene to another renderer's format");
+    convert_cmd->add_option("scene", convert_scene, "Scene file")->required()->check(CLI::ExistingFile);
+    convert_cmd
+        ->add_option("output", convert_output,
+                     "Output file; the extension picks the format: .pov = POV-Ray 3.7 (+ a matching .ini)")
+        ->required();
+
+    std::string check_scene;
+    reference::CheckOptions check_options;
+    double tolerance_codes = 2.0;
+    CLI::App* check_cmd = app.add_subcommand(
+        "check", "Render a scene with Whitted and with POV-Ray (converted) and compare them pixel by pixel");
+    check_cmd->add_option("scene", check_scene, "Scene file")->required()->check(CLI::ExistingFile);
+    check_cmd->add_option("--report", check_options.report_dir,
+                          "Write images, a difference heat map, metrics.json and report.html into this directory");
+    check_cmd->add_option("--tolerance", tolerance_codes, "Per-channel tolerance in 16-bit codes (1/65535)")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
+    check_cmd
+        ->add_option("--min-fraction", check_options.required_fraction, "Share of pixels that must be within tolerance")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1.0));
+    check_cmd->add_option("-t,--threads", check_options.threads, "Worker threads for Whitted (default: all cores)");
+    check_cmd->add_flag("-q,--quiet", check_options.quiet, "Print only the verdict line");
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        const int code = app.exit(e);
+        return code == 0 ? 0 : exit_bad_input;
+    }
+
+    if (*render_cmd) return run_render(render_args);
+    if (*convert_cmd) return run_convert(convert_scene, convert_output);
+    check_options.tolerance = tolerance_codes / 65535.0;
+    return run_check_command(check_scene, check_options);
+}

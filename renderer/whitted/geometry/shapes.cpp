@@ -1,0 +1,126 @@
+// SPDX-License-Identifier: MIT
+#include "whitted/geometry/shapes.h"
+
+#include <cmath>
+#include <limits>
+
+namespace whitted {
+namespace {
+
+/// Ray in the shape's own space: the direction is not renormalised, so t means the same
+/// distance along the world ray in both spaces.
+Ray to_object_space(const Transform& to_world, const Ray& ray) {
+    if (to_world.is_identity()) return ray;
+    return {to_world.inverse_point(ray.origin), to_world.inverse_vector(ray.direction), ray.t_min, ray.t_max};
+}
+
+void bounds_of_transformed_box(const Transform& to_world, const Vec3& lo, const Vec3& hi, Vec3& out_lo, Vec3& out_hi) {
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    out_lo = Vec3(inf);
+    out_hi = Vec3(-inf);
+    for (int corner = 0; corner < 8; ++corner) {
+        const Vec3 p{(corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y, (corner & 4) ? hi.z : lo.z};
+        const Vec3 w = to_world.apply_point(p);
+        out_lo = min(out_lo, w);
+        out_hi = max(out_hi, w);
+    }
+}
+
+}  // namespace
+
+bool intersect_sphere(const Sphere& sphere, const Ray& world_ray, double t_min, double t_max, ShapeHit& hit) {
+    const Ray ray = to_object_space(sphere.object_to_world, world_ray);
+    // Closest approach along the ray, then half the chord: the well-conditioned form.
+    const Vec3 to_center = sphere.center - ray.origin;
+    const double a = dot(ray.direction, ray.direction);
+    const double closest = dot(to_center, ray.direction) / a;
+    const double distance2 = dot(to_center, to_center) / a - closest * closest;
+    const double half_chord2 = sphere.radius * sphere.radius / a - distance2;
+    if (half_chord2 < 0) return false;
+    const double half_chord = std::sqrt(half_chord2);
+    double t = closest - half_chord;
+    if (!(t > t_min)) t = closest + half_chord;  // the ray starts inside (or past the near side)
+    if (!(t > t_min && t < t_max)) return false;
+    hit.t = t;
+    const Vec3 object_normal = (ray.at(t) - sphere.center) / sphere.radius;
+    hit.normal =
+        sphere.object_to_world.is_identity() ? object_normal : sphere.object_to_world.apply_normal(object_normal);
+    return true;
+}
+
+bool intersect_box(const Box& box, const Ray& world_ray, double t_min, double t_max, ShapeHit& hit) {
+    const Ray ray = to_object_space(box.object_to_world, world_ray);
+    double t_near = -std::numeric_limits<double>::infinity();
+    double t_far = std::numeric_limits<double>::infinity();
+    int near_axis = -1, far_axis = -1;
+    double near_sign = 0, far_sign = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+        const double o = ray.origin[axis], d = ray.direction[axis];
+        const double lo = box.min[axis], hi = box.max[axis];
+        if (d == 0) {
+            if (o < lo || o > hi) return false;  // parallel to this slab and outside it
+            continue;
+        }
+        double t0 = (lo - o) / d, t1 = (hi - o) / d;
+        double sign0 = -1, sign1 = 1;  // outward normal of the face each t belongs to
+        if (t0 > t1) std::swap(t0, t1), std::swap(sign0, sign1);
+        if (t0 > t_near) t_near = t0, near_axis = axis, near_sign = sign0;
+        if (t1 < t_far) t_far = t1, far_axis = axis, far_sign = sign1;
+        if (t_near > t_far) return false;
+    }
+    Vec3 object_normal;
+    if (t_near > t_min && t_near < t_max && near_axis >= 0) {
+        hit.t = t_near;
+        object_normal[near_axis] = near_sign;
+    } else if (t_far > t_min && t_far < t_max && far_axis >= 0) {  // the ray starts inside
+        hit.t = t_far;
+        object_normal[far_axis] = far_sign;
+    } else {
+        return false;
+    }
+    hit.normal = box.object_to_world.is_identity() ? object_normal : box.object_to_world.apply_normal(object_normal);
+    return true;
+}
+
+bool intersect_plane(const Plane& plane, const Ray& ray, double t_min, double t_max, ShapeHit& hit) {
+    const double facing = dot(plane.normal, ray.direction);
+    if (std::fabs(facing) < 1e-12) return false;  // parallel: no single hit
+    const double t = dot(plane.normal, plane.point - ray.origin) / facing;
+    if (!(t > t_min && t < t_max)) return false;
+    hit.t = t;
+    hit.normal = plane.normal;
+    return true;
+}
+
+bool intersect_triangle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Ray& ray, double t_min, double t_max,
+                        ShapeHit& hit) {
+    const Vec3 e1 = v1 - v0, e2 = v2 - v0;
+    const Vec3 p = cross(ray.direction, e2);
+    const double det = dot(e1, p);
+    if (det == 0 || !std::isfinite(det)) return false;
+    const double inv_det = 1.0 / det;
+    const Vec3 s = ray.origin - v0;
+    const double u = dot(s, p) * inv_det;
+    if (u < 0 || u > 1) return false;
+    const Vec3 q = cross(s, e1);
+    const double v = dot(ray.direction, q) * inv_det;
+    if (v < 0 || u + v > 1) return false;
+    const double t = dot(e2, q) * inv_det;
+    if (!(t > t_min && t < t_max)) return false;
+    hit.t = t;
+    hit.u = u;
+    hit.v = v;
+    hit.normal = cross(e1, e2);
+    return true;
+}
+
+void world_bounds(const Sphere& sphere, Vec3& lo, Vec3& hi) {
+    bounds_of_transformed_box(sphere.object_to_world, sphere.center - Vec3(sphere.radius),
+                              sphere.center + Vec3(sphere.radius), lo, hi);
+}
+
+void world_bounds(const Box& box, Vec3& lo, Vec3& hi) {
+    bounds_of_transformed_box(box.object_to_world, box.min, box.max, lo, hi);
+}
+
+}  // namespace whitted

@@ -1,0 +1,30 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// Ray–shape intersection in double precision. Each function finds the nearest hit with
+// t_min < t < t_max and returns its distance and outward (not yet ray-facing) normal.
+
+#include "whitted/core/ray.h"
+#include "whitted/scene/scene.h"
+
+namespace whitted {
+
+struct ShapeHit {
+    double t = 0;
+    Vec3 normal;   ///< outward geometric normal, world space, not necessarily unit
+    double u = 0;  ///< triangles: barycentric weight of vertex 1
+    double v = 0;  ///< triangles: barycentric weight of vertex 2
+};
+
+bool intersect_sphere(const Sphere& sphere, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
+bool intersect_box(const Box& box, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
+bool intersect_plane(const Plane& plane, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
+/// Möller–Trumbore; the normal is (v1 − v0) × (v2 − v0).
+bool intersect_triangle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Ray& ray, double t_min, double t_max,
+                        ShapeHit& hit);
+
+/// World-space bounds of a sphere or box (its object-space box pushed through the transform).
+void world_bounds(const Sphere& sphere, Vec3& lo, Vec3& hi);
+void world_bounds(const Box& box, Vec3& lo, Vec3& hi);
+
+}  // namespace whitted

@@ -1,0 +1,35 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include "whitted/render/renderer.h"
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace whitted {
+
+struct OutputOptions {
+    bool half = false;          ///< EXR: half floats instead of full floats
+    int bit_depth = 0;          ///< PNG/TIFF: 8 or 16; 0 = the format's default (PNG/JPEG 8, TIFF 16)
+    std::string ocio_config;    ///< empty: $OCIO, else the built-in config
+    std::string display, view;  ///< empty: the config's defaults
+    std::vector<std::pair<std::string, std::string>> metadata;  ///< extra string attributes
+};
+
+enum class OutputKind { linear_exr, display_referred };
+
+/// Which kind of file the path's extension asks for; throws std::invalid_argument naming the
+/// supported extensions when it is none of them.
+OutputKind output_kind(const std::string& path);
+
+/// Checks, before any rendering, that `path` can be written (directory exists and is writable,
+/// extension known). Throws std::invalid_argument with the reason.
+void check_output_path(const std::string& path);
+
+/// Writes the image: EXR linear; PNG/JPEG/TIFF through the OCIO display transform. The file is
+/// written to a temporary name in the same directory and renamed over `path` only when
+/// complete, so a failure never leaves a partial file or touches an existing one.
+void write_image(const Image& image, const std::string& path, const OutputOptions& options);
+
+}  // namespace whitted

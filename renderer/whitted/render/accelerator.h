@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include "whitted/core/ray.h"
+#include "whitted/scene/scene.h"
+
+#include <memory>
+
+namespace whitted {
+
+/// What a ray hit, in double precision.
+struct SurfaceHit {
+    double t = 0;
+    Vec3 point;
+    Vec3 normal;  ///< unit shading normal (interpolated for smooth meshes), not yet turned to the ray
+    uint32_t material = 0;
+};
+
+/// Ray queries over a Scene. Embree's BVH finds the candidates (triangles natively, spheres and
+/// boxes as user geometry intersected in double); infinite planes are tested directly. The hit
+/// that wins is recomputed in double from the double ray, so shading sees POV-Ray's precision.
+class Accelerator {
+public:
+    explicit Accelerator(const Scene& scene);
+    ~Accelerator();
+    Accelerator(const Accelerator&) = delete;
+    Accelerator& operator=(const Accelerator&) = delete;
+
+    /// Nearest hit with ray.t_min < t < ray.t_max.
+    bool intersect(const Ray& ray, SurfaceHit& hit) const;
+    /// Whether anything lies strictly between ray.t_min and ray.t_max (shadow rays).
+    bool occluded(const Ray& ray) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> m_impl;
+};
+
+}  // namespace whitted

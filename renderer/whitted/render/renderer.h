@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include "whitted/render/accelerator.h"
+#include "whitted/render/shading.h"
+#include "whitted/scene/scene.h"
+
+#include <atomic>
+#include <functional>
+#include <vector>
+
+namespace whitted {
+
+/// A linear, scene-referred RGB image, rows from the top.
+struct Image {
+    int width = 0, height = 0;
+    std::vector<float> rgb;  ///< 3 floats per pixel
+    const float* pixel(int x, int y) const { return &rgb[3 * (size_t(y) * width + x)]; }
+};
+
+struct RenderProgress {
+    size_t tiles_done = 0, tiles_total = 0;
+    uint64_t rays = 0;
+    double seconds = 0;
+};
+
+struct RenderOptions {
+    int threads = 0;  ///< 0 = all cores
+    /// Set from outside (a signal handler) to stop early; checked before every tile.
+    const std::atomic<bool>* cancel = nullptr;
+    /// Called from one thread a few times a second while rendering (e.g. a progress bar).
+    std::function<void(const RenderProgress&)> on_progress;
+};
+
+struct RenderResult {
+    Image image;
+    RayCounts rays;
+    double seconds = 0;
+    bool cancelled = false;
+    std::vector<bool> tile_done;  ///< which tiles were finished (for --partial)
+    int tile_size = 0;
+};
+
+/// Renders the scene in tiles on all (or `threads`) cores. Every pixel depends only on the
+/// scene, never on the order tiles finish, so the image is bit-identical for any thread count.
+RenderResult render(const Scene& scene, const Accelerator& accelerator, const RenderOptions& options);
+
+/// One pixel, all its samples averaged (box filter).
+Color render_pixel(const Scene& scene, const LectureShading& shading, int i, int j, RayCounts& counts);
+
+}  // namespace whitted

@@ -1,0 +1,157 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// The plain scene description: what the scene file says, value by value, each with the place
+// it was written. Parsing produces it; validation turns it into a renderable Scene; converters
+// (POV-Ray, ...) read it directly, never the render objects. Defaults of scene format v1 are
+// filled in here, so a reader never has to know them.
+
+#include "whitted/core/vec3.h"
+#include "whitted/scene/source_location.h"
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace whitted {
+
+/// A value and where it was written (`where` is the enclosing map's location for a default).
+template <class T>
+struct Located {
+    Located() = default;
+    Located(T v) : value(std::move(v)) {}  // NOLINT: implicit, so defaults read like `{45.0}`
+
+    T value{};
+    SourceLocation where;
+    bool given = false;  ///< written in the file, rather than defaulted
+};
+
+enum class CameraType { perspective, orthographic };
+enum class LightType { point, directional };
+enum class Highlight { blinn, phong };
+
+struct CameraDescription {
+    SourceLocation where;
+    Located<CameraType> type{CameraType::perspective};
+    Located<Vec3> eye;
+    Located<Vec3> look_at;
+    Located<Vec3> up{Vec3{0, 1, 0}};
+    Located<double> fov{45.0};        ///< horizontal, degrees (perspective)
+    Located<double> view_width{0.0};  ///< world units (orthographic)
+};
+
+struct ImageDescription {
+    SourceLocation where;
+    Located<int64_t> width;
+    Located<int64_t> height;
+    Located<Color> background{Color{0.0}};
+    Located<int64_t> samples{1};
+};
+
+struct LightDescription {
+    SourceLocation where;
+    LightType type = LightType::point;
+    Located<Vec3> position;   ///< point lights
+    Located<Vec3> direction;  ///< directional lights: the way the light travels
+    Located<Color> intensity{Color{1.0}};
+};
+
+/// The lecture's material: L = ka·Ia + Σ[kd·I·(n·l) + ks·I·(n·h)^p] + km·L(r).
+struct MaterialDescription {
+    SourceLocation where;
+    std::string name;  ///< empty for an inline material
+    Located<Color> ka{Color{0.0}};
+    Located<Color> kd{Color{0.0}};
+    Located<Color> ks{Color{0.0}};
+    Located<double> p{1.0};
+    Located<Color> km{Color{0.0}};
+    Located<Highlight> highlight{Highlight::blinn};
+};
+
+/// `material:` on an object: a name from `materials`, or an inline map.
+struct MaterialReference {
+    SourceLocation where;
+    std::string name;                            ///< set for a reference by name
+    std::optional<MaterialDescription> inline_;  ///< set for an inline material
+};
+
+struct TransformStep {
+    enum class Kind { scale, rotate, translate, matrix };
+    SourceLocation where;
+    Kind kind = Kind::translate;
+    Vec3 vector;                      ///< scale factors, rotation axis or translation
+    double angle = 0;                 ///< rotate: degrees, right-hand rule
+    std::array<double, 16> matrix{};  ///< matrix: row-major 4x4
+};
+
+enum class ObjectType { sphere, plane, box, triangle, mesh, group };
+
+struct ObjectDescription {
+    SourceLocation where;
+    ObjectType type = ObjectType::sphere;
+    std::vector<TransformStep> transform;  ///< applied in list order
+    std::optional<MaterialReference> material;
+
+    // sphere
+    Located<Vec3> center;
+    Located<double> radius;
+    // plane
+    Located<Vec3> point;
+    Located<Vec3> normal;
+    // box
+    Located<Vec3> min;
+    Located<Vec3> max;
+    // triangle (3 vertices) and inline mesh
+    SourceLocation vertices_where;
+    std::vector<Vec3> vertices;
+    // inline mesh
+    SourceLocation triangles_where;
+    std::vector<std::array<int64_t, 3>> triangles;
+    std::vector<SourceLocation> triangle_where;  ///< one per triangle, for index errors
+    SourceLocation normals_where;
+    std::vector<Vec3> normals;
+    // mesh from a file
+    Located<std::string> file;  ///< as written in the scene
+    std::string file_path;      ///< resolved against the scene file's directory
+    // group
+    std::vector<ObjectDescription> children;
+};
+
+struct SceneDescription {
+    std::string path;  ///< the scene file as given
+    Located<int64_t> version{1};
+    CameraDescription camera;
+    ImageDescription image;
+    Located<int64_t> max_depth{5};
+    Located<Color> ambient{Color{1.0}};
+    std::vector<LightDescription> lights;
+    std::vector<MaterialDescription> materials;  ///< in file order
+    std::vector<ObjectDescription> objects;
+
+    const MaterialDescription* find_material(const std::string& name) const;
+};
+
+/// Limits that keep a hostile or mistaken scene from exhausting the machine; each is reported
+/// with a clear message rather than a crash (docs/scene-format.md lists them).
+namespace limits {
+inline constexpr int64_t max_image_side = 65536;
+inline constexpr int64_t max_image_pixels = int64_t(1) << 28;  // 268 M pixels
+inline constexpr int64_t max_samples = 64;
+inline constexpr int64_t max_depth = 256;
+inline constexpr int max_nesting = 64;  ///< groups inside groups
+inline constexpr int64_t max_scene_file_bytes = int64_t(256) << 20;
+inline constexpr int64_t max_mesh_file_bytes = int64_t(2) << 30;
+inline constexpr int64_t max_triangles = int64_t(64) << 20;  // 67 M triangles
+inline constexpr int64_t max_yaml_nodes = 50'000'000;        ///< stops alias ("billion laughs") bombs
+}  // namespace limits
+
+/// Reads a scene file (YAML or JSON). Throws InputError naming file:line:col on any problem.
+SceneDescription parse_scene_file(const std::string& path);
+/// Same, from text already in memory; `path` is used for messages and relative mesh paths.
+SceneDescription parse_scene_text(const std::string& text, const std::string& path);
+
+const char* to_string(ObjectType type);
+
+}  // namespace whitted

@@ -1,0 +1,598 @@
+// SPDX-License-Identifier: MIT
+// Scene format v1 (YAML, or JSON as YAML) → SceneDescription. Every value keeps its file, line
+// and column; every mistake becomes an InputError at the place it was made. Ranges that need
+// more than one value (eye ≠ look_at, min < max, ...) are checked in validate.cpp.
+
+#include "whitted/scene/description.h"
+#include "whitted/scene/text_checks.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace whitted {
+namespace {
+
+struct ParseContext {
+    std::string file;
+    std::string directory;
+    int64_t nodes_seen = 0;
+
+    SourceLocation at(const YAML::Node& node) const {
+        const YAML::Mark mark = node.Mark();
+        if (mark.is_null()) return {file, 0, 0};
+        return {file, mark.line + 1, mark.column + 1};
+    }
+    [[noreturn]] void fail(const YAML::Node& node, const std::string& message) const {
+        throw InputError(at(node), message);
+    }
+};
+
+std::string describe(const YAML::Node& node) {
+    switch (node.Type()) {
+        case YAML::NodeType::Null:
+            return "nothing (null)";
+        case YAML::NodeType::Sequence:
+            return "a list";
+        case YAML::NodeType::Map:
+            return "a map";
+        case YAML::NodeType::Scalar: {
+            std::string s = node.Scalar();
+            if (s.size() > 40) s = s.substr(0, 37) + "...";
+            return node.Tag() == "!" ? "the string \"" + s + "\"" : "'" + s + "'";
+        }
+        default:
+            return "nothing";
+    }
+}
+
+double parse_number(const ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+    if (!node.IsScalar() || node.Tag() == "!") ctx.fail(node, what + ": expected a number, got " + describe(node));
+    std::string text = node.Scalar();
+    std::string_view view = text;
+    if (!view.empty() && view.front() == '+') view.remove_prefix(1);
+    // YAML's own spellings of the special values, so that they get the "finite" message below.
+    std::string lowered(view);
+    std::transform(lowered.begin(), lowered.end(), lowered.begin(), ::tolower);
+    if (lowered == ".nan" || lowered == "nan" || lowered == ".inf" || lowered == "inf" || lowered == "-.inf" ||
+        lowered == "-inf" || lowered == "infinity" || lowered == "-infinity")
+        ctx.fail(node, what + ": must be a finite number, got '" + text + "'");
+    double value = 0;
+    const auto [end, error] = std::from_chars(view.data(), view.data() + view.size(), value);
+    if (error == std::errc::result_out_of_range) ctx.fail(node, what + ": number '" + text + "' is out of range");
+    if (error != std::errc() || end != view.data() + view.size())
+        ctx.fail(node, what + ": expected a number, got " + describe(node));
+    if (!std::isfinite(value)) ctx.fail(node, what + ": must be a finite number, got '" + text + "'");
+    return value;
+}
+
+int64_t parse_integer(const ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+    const double value = parse_number(ctx, node, what);
+    if (value != std::floor(value) || std::fabs(value) > 9.0e15)
+        ctx.fail(node, what + ": expected a whole number, got " + describe(node));
+    return static_cast<int64_t>(value);
+}
+
+Vec3 parse_vec3(const ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+    if (!node.IsSequence()) ctx.fail(node, what + ": expected a list of 3 numbers [x, y, z], got " + describe(node));
+    if (node.size() != 3) ctx.fail(node, what + ": expected 3 numbers, got a list of " + std::to_string(node.size()));
+    return {parse_number(ctx, node[0], what), parse_number(ctx, node[1], what), parse_number(ctx, node[2], what)};
+}
+
+/// A colour: [r, g, b], or one number c meaning [c, c, c].
+Color parse_color(const ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+    if (node.IsScalar()) return Color(parse_number(ctx, node, what));
+    if (!node.IsSequence()) ctx.fail(node, what + ": expected a colour [r, g, b] or a number, got " + describe(node));
+    return parse_vec3(ctx, node, what);
+}
+
+std::string parse_string(const ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+    if (!node.IsScalar()) ctx.fail(node, what + ": expected a name, got " + describe(node));
+    return node.Scalar();
+}
+
+size_t edit_distance(const std::string& a, const std::string& b) {
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+        size_t diagonal = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= b.size(); ++j) {
+            const size_t above = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
+            diagonal = above;
+        }
+    }
+    return row[b.size()];
+}
+
+}  // namespace
+
+std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates) {
+    std::string best;
+    size_t best_distance = std::max<size_t>(2, word.size() / 3) + 1;
+    for (const auto& candidate : candidates) {
+        const size_t d = edit_distance(word, candidate);
+        if (d < best_distance) best_distance = d, best = candidate;
+    }
+    return best.empty() ? std::string() : " (did you mean '" + best + "'?)";
+}
+
+namespace {
+
+std::string join(const std::vector<std::string>& words) {
+    std::string out;
+    for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
+    return out;
+}
+
+/// Reads one YAML map: rejects unknown keys (with a suggestion) and finds values by key.
+class MapReader {
+public:
+    MapReader(ParseContext& ctx, const YAML::Node& node, std::string what, std::vector<std::string> allowed)
+        : m_ctx(ctx), m_node(node), m_what(std::move(what)), m_allowed(std::move(allowed)) {
+        if (!node.IsMap()) ctx.fail(node, m_what + ": expected a map of keys, got " + describe(node));
+        for (const auto& entry : node) {
+            const YAML::Node& key = entry.first;
+            if (!key.IsScalar()) ctx.fail(key, m_what + ": keys must be plain names");
+            const std::string name = key.Scalar();
+            if (std::find(m_allowed.begin(), m_allowed.end(), name) == m_allowed.end())
+                ctx.fail(key, m_what + ": unknown key '" + name + "'" + did_you_mean(name, m_allowed) +
+                                  "; expected one of: " + join(m_allowed));
+            for (const auto& seen : m_keys)
+                if (seen == name) ctx.fail(key, m_what + ": key '" + name + "' is given twice");
+            m_keys.push_back(name);
+        }
+    }
+
+    bool has(const std::string& key) const { return std::find(m_keys.begin(), m_keys.end(), key) != m_keys.end(); }
+    YAML::Node get(const std::string& key) const { return m_node[key]; }
+    SourceLocation where() const { return m_ctx.at(m_node); }
+    std::string what(const std::string& key) const { return m_what + "." + key; }
+
+    YAML::Node require(const std::string& key) const {
+        if (!has(key)) m_ctx.fail(m_node, m_what + ": missing required key '" + key + "'");
+        return get(key);
+    }
+
+    template <class T, class ParseFn>
+    void read(Located<T>& out, const std::string& key, ParseFn parse, bool required = false) const {
+        if (!has(key)) {
+            if (required) require(key);
+            out.where = where();
+            return;
+        }
+        const YAML::Node value = get(key);
+        out.value = parse(m_ctx, value, what(key));
+        out.where = m_ctx.at(value);
+        out.given = true;
+    }
+    void number(Located<double>& out, const std::string& key, bool required = false) const {
+        read(out, key, parse_number, required);
+    }
+    void integer(Located<int64_t>& out, const std::string& key, bool required = false) const {
+        read(out, key, parse_integer, required);
+    }
+    void vec3(Located<Vec3>& out, const std::string& key, bool required = false) const {
+        read(out, key, parse_vec3, required);
+    }
+    void color(Located<Color>& out, const std::string& key, bool required = false) const {
+        read(out, key, parse_color, required);
+    }
+
+private:
+    ParseContext& m_ctx;
+    YAML::Node m_node;
+    std::string m_what;
+    std::vector<std::string> m_allowed;
+    std::vector<std::string> m_keys;
+};
+
+/// Picks one of a fixed set of words, e.g. a camera type.
+template <class Enum>
+Enum parse_choice(const ParseContext& ctx, const YAML::Node& node, const std::string& what,
+                  const std::vector<std::pair<std::string, Enum>>& choices) {
+    const std::string word = parse_string(ctx, node, what);
+    std::vector<std::string> names;
+    for (const auto& [name, value] : choices) {
+        if (name == word) return value;
+        names.push_back(name);
+    }
+    ctx.fail(node,
+             what + ": unknown value '" + word + "'" + did_you_mean(word, names) + "; expected one of: " + join(names));
+}
+
+/// Counts every node reachable from `node`, following aliases, and refuses documents past
+/// limits::max_yaml_nodes: a few lines of nested aliases can expand to billions of nodes.
+void count_nodes(ParseContext& ctx, const YAML::Node& node, int depth) {
+    if (++ctx.nodes_seen > limits::max_yaml_nodes)
+        ctx.fail(node, "the document expands to more than " + std::to_string(limits::max_yaml_nodes) +
+                           " values (nested aliases?); refusing to read it");
+    if (depth > 512) ctx.fail(node, "values nested more than 512 levels deep");
+    if (node.IsSequence() || node.IsMap()) {
+        for (const auto& child : node) {
+            if (node.IsMap()) {
+                count_nodes(ctx, child.first, depth + 1);
+                count_nodes(ctx, child.second, depth + 1);
+            } else {
+                count_nodes(ctx, child, depth + 1);
+            }
+        }
+    }
+}
+
+CameraDescription parse_camera(ParseContext& ctx, const YAML::Node& node) {
+    MapReader map(ctx, node, "camera", {"type", "eye", "look_at", "up", "fov", "view_width"});
+    CameraDescription camera;
+    camera.where = map.where();
+    map.read(camera.type, "type", [](const ParseContext& c, const YAML::Node& n, const std::string& w) {
+        return parse_choice<CameraType>(
+            c, n, w, {{"perspective", CameraType::perspective}, {"orthographic", CameraType::orthographic}});
+    });
+    map.vec3(camera.eye, "eye", true);
+    map.vec3(camera.look_at, "look_at", true);
+    map.vec3(camera.up, "up");
+    map.number(camera.fov, "fov");
+    map.number(camera.view_width, "view_width", camera.type.value == CameraType::orthographic);
+    return camera;
+}
+
+ImageDescription parse_image(ParseContext& ctx, const YAML::Node& node) {
+    MapReader map(ctx, node, "image", {"width", "height", "background", "samples"});
+    ImageDescription image;
+    image.where = map.where();
+    map.integer(image.width, "width", true);
+    map.integer(image.height, "height", true);
+    map.color(image.background, "background");
+    map.integer(image.samples, "samples");
+    return image;
+}
+
+LightDescription parse_light(ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+    if (!node.IsMap()) ctx.fail(node, what + ": expected a map with 'type', got " + describe(node));
+    const YAML::Node type_node = node["type"];
+    if (!type_node) ctx.fail(node, what + ": missing required key 'type' (point or directional)");
+    LightDescription light;
+    light.type = parse_choice<LightType>(ctx, type_node, what + ".type",
+                                         {{"point", LightType::point}, {"directional", LightType::directional}});
+    if (light.type == LightType::point) {
+        MapReader map(ctx, node, what + " (point)", {"type", "position", "intensity"});
+        light.where = map.where();
+        map.vec3(light.position, "position", true);
+        map.color(light.intensity, "intensity");
+    } else {
+        MapReader map(ctx, node, what + " (directional)", {"type", "direction", "intensity"});
+        light.where = map.where();
+        map.vec3(light.direction, "direction", true);
+        map.color(light.intensity, "intensity");
+    }
+    return light;
+}
+
+MaterialDescription parse_material(ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+    MapReader map(ctx, node, what, {"ka", "kd", "ks", "p", "km", "highlight"});
+    MaterialDescription material;
+    material.where = map.where();
+    map.color(material.ka, "ka");
+    map.color(material.kd, "kd");
+    map.color(material.ks, "ks");
+    map.number(material.p, "p");
+    map.color(material.km, "km");
+    map.read(material.highlight, "highlight", [](const ParseContext& c, const YAML::Node& n, const std::string& w) {
+        return parse_choice<Highlight>(c, n, w, {{"blinn", Highlight::blinn}, {"phong", Highlight::phong}});
+    });
+    return material;
+}
+
+MaterialReference parse_material_reference(ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+    MaterialReference reference;
+    reference.where = ctx.at(node);
+    if (node.IsScalar() && node.Tag() != "!" && node.Scalar().empty())
+        ctx.fail(node, what + ": expected a material name or an inline material map");
+    if (node.IsScalar()) {
+        reference.name = node.Scalar();
+    } else if (node.IsMap()) {
+        reference.inline_ = parse_material(ctx, node, what);
+    } else {
+        ctx.fail(node, what + ": expected a material name or an inline material map, got " + describe(node));
+    }
+    return reference;
+}
+
+std::vector<TransformStep> parse_transform(ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+    const auto parse_step = [&](const YAML::Node& step_node, const std::string& step_what) {
+        MapReader map(ctx, step_node, step_what, {"scale", "rotate", "translate", "matrix"});
+        int count = map.has("scale") + map.has("rotate") + map.has("translate") + map.has("matrix");
+        if (count != 1)
+            ctx.fail(step_node, step_what + ": each step is exactly one of scale, rotate, translate or matrix");
+        TransformStep step;
+        step.where = map.where();
+        if (map.has("scale")) {
+            const YAML::Node value = map.get("scale");
+            step.kind = TransformStep::Kind::scale;
+            step.where = ctx.at(value);
+            step.vector = value.IsScalar() ? Vec3(parse_number(ctx, value, step_what + ".scale"))
+                                           : parse_vec3(ctx, value, step_what + ".scale");
+        } else if (map.has("translate")) {
+            const YAML::Node value = map.get("translate");
+            step.kind = TransformStep::Kind::translate;
+            step.where = ctx.at(value);
+            step.vector = parse_vec3(ctx, value, step_what + ".translate");
+        } else if (map.has("rotate")) {
+            MapReader rotate(ctx, map.get("rotate"), step_what + ".rotate", {"axis", "angle"});
+            step.kind = TransformStep::Kind::rotate;
+            step.where = rotate.where();
+            step.vector = parse_vec3(ctx, rotate.require("axis"), step_what + ".rotate.axis");
+            step.angle = parse_number(ctx, rotate.require("angle"), step_what + ".rotate.angle");
+        } else {
+            const YAML::Node value = map.get("matrix");
+            step.kind = TransformStep::Kind::matrix;
+            step.where = ctx.at(value);
+            if (!value.IsSequence() || value.size() != 16)
+                ctx.fail(value,
+                         step_what + ".matrix: expected 16 numbers (a row-major 4x4 matrix), got " +
+                             (value.IsSequence() ? "a list of " + std::to_string(value.size()) : describe(value)));
+            for (size_t i = 0; i < 16; ++i) step.matrix[i] = parse_number(ctx, value[i], step_what + ".matrix");
+        }
+        return step;
+    };
+
+    std::vector<TransformStep> steps;
+    if (node.IsMap()) {
+        steps.push_back(parse_step(node, what));
+    } else if (node.IsSequence()) {
+        for (size_t i = 0; i < node.size(); ++i)
+            steps.push_back(parse_step(node[i], what + "[" + std::to_string(i) + "]"));
+    } else {
+        ctx.fail(node, what +
+                           ": expected a list of steps (scale, rotate, translate) or { matrix: [16 numbers] }, got " +
+                           describe(node));
+    }
+    return steps;
+}
+
+std::vector<Vec3> parse_vec3_list(ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+    if (!node.IsSequence()) ctx.fail(node, what + ": expected a list of [x, y, z], got " + describe(node));
+    std::vector<Vec3> out;
+    out.reserve(node.size());
+    for (size_t i = 0; i < node.size(); ++i)
+        out.push_back(parse_vec3(ctx, node[i], what + "[" + std::to_string(i) + "]"));
+    return out;
+}
+
+ObjectDescription parse_object(ParseContext& ctx, const YAML::Node& node, const std::string& what, int depth);
+
+std::vector<ObjectDescription> parse_objects(ParseContext& ctx, const YAML::Node& node, const std::string& what,
+                                             int depth) {
+    if (node.IsNull()) return {};
+    if (!node.IsSequence()) ctx.fail(node, what + ": expected a list of objects, got " + describe(node));
+    std::vector<ObjectDescription> objects;
+    for (size_t i = 0; i < node.size(); ++i)
+        objects.push_back(parse_object(ctx, node[i], what + "[" + std::to_string(i) + "]", depth));
+    return objects;
+}
+
+ObjectDescription parse_object(ParseContext& ctx, const YAML::Node& node, const std::string& what, int depth) {
+    if (!node.IsMap()) ctx.fail(node, what + ": expected a map with 'type', got " + describe(node));
+    const YAML::Node type_node = node["type"];
+    if (!type_node)
+        ctx.fail(node, what + ": missing required key 'type' (sphere, plane, box, triangle, mesh or group)");
+    ObjectDescription object;
+    object.type = parse_choice<ObjectType>(ctx, type_node, what + ".type",
+                                           {{"sphere", ObjectType::sphere},
+                                            {"plane", ObjectType::plane},
+                                            {"box", ObjectType::box},
+                                            {"triangle", ObjectType::triangle},
+                                            {"mesh", ObjectType::mesh},
+                                            {"group", ObjectType::group}});
+    const std::string label = what + " (" + to_string(object.type) + ")";
+    std::vector<std::string> keys{"type", "transform"};
+    if (object.type != ObjectType::group) keys.push_back("material");
+    switch (object.type) {
+        case ObjectType::sphere:
+            keys.insert(keys.end(), {"center", "radius"});
+            break;
+        case ObjectType::plane:
+            keys.insert(keys.end(), {"point", "normal"});
+            break;
+        case ObjectType::box:
+            keys.insert(keys.end(), {"min", "max"});
+            break;
+        case ObjectType::triangle:
+            keys.insert(keys.end(), {"vertices"});
+            break;
+        case ObjectType::mesh:
+            keys.insert(keys.end(), {"file", "vertices", "triangles", "normals"});
+            break;
+        case ObjectType::group:
+            keys.insert(keys.end(), {"objects"});
+            break;
+    }
+    MapReader map(ctx, node, label, keys);
+    object.where = map.where();
+    if (map.has("transform")) object.transform = parse_transform(ctx, map.get("transform"), label + ".transform");
+    if (map.has("material")) object.material = parse_material_reference(ctx, map.get("material"), label + ".material");
+
+    switch (object.type) {
+        case ObjectType::sphere:
+            map.vec3(object.center, "center", true);
+            map.number(object.radius, "radius", true);
+            break;
+        case ObjectType::plane:
+            map.vec3(object.point, "point", true);
+            map.vec3(object.normal, "normal", true);
+            break;
+        case ObjectType::box:
+            map.vec3(object.min, "min", true);
+            map.vec3(object.max, "max", true);
+            break;
+        case ObjectType::triangle: {
+            const YAML::Node vertices = map.require("vertices");
+            object.vertices_where = ctx.at(vertices);
+            object.vertices = parse_vec3_list(ctx, vertices, label + ".vertices");
+            if (object.vertices.size() != 3)
+                ctx.fail(vertices, label + ".vertices: a triangle needs exactly 3 vertices, got " +
+                                       std::to_string(object.vertices.size()));
+            break;
+        }
+        case ObjectType::mesh: {
+            if (map.has("file")) {
+                for (const char* inline_key : {"vertices", "triangles", "normals"})
+                    if (map.has(inline_key))
+                        ctx.fail(map.get(inline_key),
+                                 label + ": give either 'file' or inline 'vertices'/'triangles', not both");
+                map.read(object.file, "file", parse_string);
+                if (object.file.value.empty()) ctx.fail(map.get("file"), label + ".file: empty path");
+                const std::filesystem::path file(object.file.value);
+                object.file_path =
+                    file.is_absolute() ? file.string() : (std::filesystem::path(ctx.directory) / file).string();
+                break;
+            }
+            if (!map.has("vertices") && !map.has("triangles"))
+                ctx.fail(node, label + ": a mesh needs 'file', or inline 'vertices' and 'triangles'");
+            const YAML::Node vertices = map.require("vertices");
+            object.vertices_where = ctx.at(vertices);
+            object.vertices = parse_vec3_list(ctx, vertices, label + ".vertices");
+            const YAML::Node triangles = map.require("triangles");
+            object.triangles_where = ctx.at(triangles);
+            if (!triangles.IsSequence())
+                ctx.fail(triangles, label + ".triangles: expected a list of [i, j, k], got " + describe(triangles));
+            for (size_t i = 0; i < triangles.size(); ++i) {
+                const YAML::Node triangle = triangles[i];
+                const std::string item = label + ".triangles[" + std::to_string(i) + "]";
+                if (!triangle.IsSequence() || triangle.size() != 3)
+                    ctx.fail(triangle, item + ": expected 3 vertex indices [i, j, k], got " +
+                                           (triangle.IsSequence() ? "a list of " + std::to_string(triangle.size())
+                                                                  : describe(triangle)));
+                object.triangles.push_back({parse_integer(ctx, triangle[0], item),
+                                            parse_integer(ctx, triangle[1], item),
+                                            parse_integer(ctx, triangle[2], item)});
+                object.triangle_where.push_back(ctx.at(triangle));
+            }
+            if (map.has("normals")) {
+                const YAML::Node normals = map.get("normals");
+                object.normals_where = ctx.at(normals);
+                object.normals = parse_vec3_list(ctx, normals, label + ".normals");
+            }
+            break;
+        }
+        case ObjectType::group: {
+            if (depth + 1 > limits::max_nesting)
+                ctx.fail(node,
+                         label + ": groups nested deeper than " + std::to_string(limits::max_nesting) + " levels");
+            const YAML::Node children = map.require("objects");
+            object.children = parse_objects(ctx, children, label + ".objects", depth + 1);
+            break;
+        }
+    }
+    return object;
+}
+
+SceneDescription parse_document(ParseContext& ctx, const YAML::Node& root) {
+    if (!root || root.IsNull())
+        throw InputError({ctx.file, 1, 1}, "the scene is empty: expected a map with 'camera', 'image' and 'objects'");
+    count_nodes(ctx, root, 0);
+    MapReader map(ctx, root, "scene",
+                  {"version", "camera", "image", "render", "ambient", "lights", "materials", "objects"});
+    SceneDescription scene;
+    scene.path = ctx.file;
+    map.integer(scene.version, "version");
+    if (scene.version.value != 1)
+        throw InputError(scene.version.where, "unsupported scene format version " +
+                                                  std::to_string(scene.version.value) +
+                                                  "; this Whitted reads version 1");
+    scene.camera = parse_camera(ctx, map.require("camera"));
+    scene.image = parse_image(ctx, map.require("image"));
+    if (map.has("render")) {
+        MapReader render(ctx, map.get("render"), "render", {"max_depth"});
+        render.integer(scene.max_depth, "max_depth");
+    } else {
+        scene.max_depth.where = map.where();
+    }
+    map.color(scene.ambient, "ambient");
+    if (map.has("lights")) {
+        const YAML::Node lights = map.get("lights");
+        if (!lights.IsNull()) {
+            if (!lights.IsSequence()) ctx.fail(lights, "lights: expected a list of lights, got " + describe(lights));
+            for (size_t i = 0; i < lights.size(); ++i)
+                scene.lights.push_back(parse_light(ctx, lights[i], "lights[" + std::to_string(i) + "]"));
+        }
+    }
+    if (map.has("materials")) {
+        const YAML::Node materials = map.get("materials");
+        if (!materials.IsNull()) {
+            if (!materials.IsMap())
+                ctx.fail(materials, "materials: expected a map of name: material, got " + describe(materials));
+            for (const auto& entry : materials) {
+                if (!entry.first.IsScalar() || entry.first.Scalar().empty())
+                    ctx.fail(entry.first, "materials: names must be plain, non-empty words");
+                const std::string name = entry.first.Scalar();
+                if (scene.find_material(name)) ctx.fail(entry.first, "materials: '" + name + "' is defined twice");
+                MaterialDescription material = parse_material(ctx, entry.second, "materials." + name);
+                material.name = name;
+                scene.materials.push_back(std::move(material));
+            }
+        }
+    }
+    if (map.has("objects")) scene.objects = parse_objects(ctx, map.get("objects"), "objects", 0);
+    return scene;
+}
+
+}  // namespace
+
+const MaterialDescription* SceneDescription::find_material(const std::string& name) const {
+    for (const auto& material : materials)
+        if (material.name == name) return &material;
+    return nullptr;
+}
+
+const char* to_string(ObjectType type) {
+    switch (type) {
+        case ObjectType::sphere:
+            return "sphere";
+        case ObjectType::plane:
+            return "plane";
+        case ObjectType::box:
+            return "box";
+        case ObjectType::triangle:
+            return "triangle";
+        case ObjectType::mesh:
+            return "mesh";
+        case ObjectType::group:
+            return "group";
+    }
+    return "object";
+}
+
+SceneDescription parse_scene_text(const std::string& text, const std::string& path) {
+    ParseContext ctx;
+    ctx.file = path;
+    ctx.directory = std::filesystem::path(path).parent_path().string();
+    check_text_is_readable(text, path);
+    YAML::Node root;
+    try {
+        root = YAML::Load(text);
+    } catch (const YAML::ParserException& e) {
+        throw InputError({path, e.mark.line + 1, e.mark.column + 1}, "syntax error: " + e.msg);
+    } catch (const YAML::Exception& e) {
+        throw InputError({path, e.mark.is_null() ? 0 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1},
+                         std::string("cannot read the scene: ") + e.msg);
+    }
+    try {
+        return parse_document(ctx, root);
+    } catch (const YAML::Exception& e) {  // e.g. a bad conversion deep inside yaml-cpp
+        throw InputError({path, e.mark.is_null() ? 0 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1},
+                         std::string("cannot read the scene: ") + e.msg);
+    }
+}
+
+SceneDescription parse_scene_file(const std::string& path) {
+    return parse_scene_text(read_text_file(path, limits::max_scene_file_bytes, "scene file"), path);
+}
+
+}  // namespace whitted

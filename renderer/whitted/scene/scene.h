@@ -1,0 +1,102 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// The validated, renderable scene: every value checked, every transform folded into world
+// space where that is exact (triangles, planes), kept beside the shape where it is not
+// (spheres and boxes stay analytic in their own space).
+
+#include "whitted/core/transform.h"
+#include "whitted/core/vec3.h"
+#include "whitted/scene/description.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace whitted {
+
+/// The lecture's material, a plain struct of coefficients (colours are per channel).
+struct Material {
+    Color ka;      ///< ambient
+    Color kd;      ///< diffuse (Lambert)
+    Color ks;      ///< specular
+    double p = 1;  ///< specular exponent
+    Color km;      ///< mirror
+    Highlight highlight = Highlight::blinn;
+};
+
+struct Camera {
+    CameraType type = CameraType::perspective;
+    Vec3 eye;
+    Vec3 forward;  ///< unit view direction
+    Vec3 right;    ///< scaled: screen x in [-0.5, 0.5] maps to ±right/2
+    Vec3 up;       ///< scaled like right, for screen y
+};
+
+struct Light {
+    LightType type = LightType::point;
+    Vec3 position;      ///< point lights
+    Vec3 toward_light;  ///< directional lights: unit l, minus the travel direction
+    Color intensity;
+};
+
+struct Sphere {
+    Transform object_to_world;  ///< identity for most spheres
+    Vec3 center;
+    double radius = 1;
+    uint32_t material = 0;
+};
+
+struct Box {
+    Transform object_to_world;
+    Vec3 min, max;
+    uint32_t material = 0;
+};
+
+struct Plane {
+    Vec3 point;
+    Vec3 normal;  ///< unit
+    uint32_t material = 0;
+};
+
+/// Triangles in world space, stored as Embree wants them (float, xyz + padding). Positions
+/// are float as Embree needs; hits are recomputed in double from these same floats.
+struct TriangleMesh {
+    std::vector<float> positions;              ///< 4 floats per vertex (x, y, z, unused)
+    std::vector<uint32_t> indices;             ///< 3 per triangle
+    std::vector<float> normals;                ///< empty, or 3 floats per vertex: smooth shading
+    std::vector<uint32_t> triangle_materials;  ///< empty when every triangle uses `material`
+    uint32_t material = 0;
+    size_t triangle_count() const { return indices.size() / 3; }
+    size_t vertex_count() const { return positions.size() / 4; }
+};
+
+struct Scene {
+    std::string path;
+    int width = 0, height = 0;
+    int samples = 1;
+    int max_depth = 5;
+    Color background;
+    Color ambient;  ///< I_a
+    Camera camera;
+    std::vector<Light> lights;
+    std::vector<Material> materials;
+    std::vector<Sphere> spheres;
+    std::vector<Box> boxes;
+    std::vector<Plane> planes;
+    std::vector<TriangleMesh> meshes;
+
+    size_t triangle_count() const;
+};
+
+/// Checks every value of a description and builds the scene (loading mesh files). Throws
+/// InputError naming file:line:col for anything out of range.
+Scene validate_scene(const SceneDescription& description);
+
+/// Builds the camera's basis from its description (also used by the converters' tests).
+Camera make_camera(const CameraDescription& camera, int width, int height);
+
+/// The object-to-world transform of a list of steps (applied in list order).
+Transform make_transform(const std::vector<TransformStep>& steps);
+
+}  // namespace whitted

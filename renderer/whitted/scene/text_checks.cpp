@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: MIT
+#include "whitted/scene/text_checks.h"
+
+#include "whitted/scene/source_location.h"
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace whitted {
+
+std::string read_text_file(const std::string& path, int64_t max_bytes, const std::string& what) {
+    std::error_code error;
+    const auto status = std::filesystem::status(path, error);
+    if (error || !std::filesystem::exists(status)) throw InputError({path}, what + " not found");
+    if (std::filesystem::is_directory(status)) throw InputError({path}, what + " is a directory, not a file");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError({path}, "cannot open the " + what + ": " + std::strerror(errno));
+    in.seekg(0, std::ios::end);
+    const std::streamoff size = in.tellg();
+    if (size > max_bytes)
+        throw InputError({path},
+                         what + " is " + std::to_string(size) + " bytes; the limit is " + std::to_string(max_bytes));
+    in.seekg(0, std::ios::beg);
+    std::string text;
+    if (size > 0) {
+        text.resize(static_cast<size_t>(size));
+        in.read(text.data(), size);
+    } else {  // pipes and other files without a size
+        std::ostringstream buffer;
+        buffer << in.rdbuf();
+        text = buffer.str();
+    }
+    if (in.bad()) throw InputError({path}, "cannot read the " + what + ": " + std::strerror(errno));
+    return text;
+}
+
+void check_text_is_readable(const std::string& text, const std::string& path) {
+    int line = 1, column = 1;
+    const auto* bytes = reinterpret_cast<const unsigned char*>(text.data());
+    const size_t n = text.size();
+    for (size_t i = 0; i < n;) {
+        const unsigned char c = bytes[i];
+        if (c == 0) throw InputError({path, line, column}, "the file contains a NUL byte: is it a binary file?");
+        size_t extra = 0;
+        if (c < 0x80)
+            extra = 0;
+        else if ((c & 0xE0) == 0xC0 && c >= 0xC2)
+            extra = 1;
+        else if ((c & 0xF0) == 0xE0)
+            extra = 2;
+        else if ((c & 0xF8) == 0xF0 && c <= 0xF4)
+            extra = 3;
+        else
+            throw InputError({path, line, column}, "the file is not valid UTF-8 text");
+        if (i + extra >= n + (extra == 0 ? 1 : 0) && extra > 0 && i + extra >= n)
+            throw InputError({path, line, column}, "the file is not valid UTF-8 text (truncated character)");
+        for (size_t k = 1; k <= extra; ++k)
+            if ((bytes[i + k] & 0xC0) != 0x80)
+                throw InputError({path, line, column}, "the file is not valid UTF-8 text");
+        if (c == '\n')
+            line += 1, column = 1;
+        else
+            column += 1;
+        i += extra + 1;
+    }
+}
+
+}  // namespace whitted

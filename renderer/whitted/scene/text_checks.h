@@ -1,0 +1,21 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace whitted {
+
+/// Reads a whole file, refusing files larger than `max_bytes`, directories and unreadable
+/// paths with an InputError naming the file (`what` says what the file was meant to be).
+std::string read_text_file(const std::string& path, int64_t max_bytes, const std::string& what);
+
+/// Refuses text a YAML parser should never see: NUL bytes (binary files) and invalid UTF-8,
+/// reported at the line and column of the first bad byte.
+void check_text_is_readable(const std::string& text, const std::string& path);
+
+/// " (did you mean 'x'?)" for the closest candidate within a small edit distance, else "".
+std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates);
+
+}  // namespace whitted

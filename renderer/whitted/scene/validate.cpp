@@ -1,0 +1,340 @@
+// SPDX-License-Identifier: MIT
+// SceneDescription → Scene: range checks that need whole values (or several of them), material
+// names resolved, transforms folded, meshes loaded. Every refusal names file:line:col.
+
+#include "whitted/scene/mesh_file.h"
+#include "whitted/scene/scene.h"
+#include "whitted/scene/text_checks.h"
+
+#include <cmath>
+#include <numbers>
+#include <unordered_map>
+
+namespace whitted {
+namespace {
+
+[[noreturn]] void fail(const SourceLocation& where, const std::string& message) {
+    throw InputError(where, message);
+}
+
+void require_non_negative(const Located<Color>& c, const std::string& what) {
+    if (c.value.x < 0 || c.value.y < 0 || c.value.z < 0) fail(c.where, what + " must not be negative");
+}
+
+void require_non_zero(const Located<Vec3>& v, const std::string& what) {
+    if (is_zero(v.value)) fail(v.where, what + " must not be the zero vector");
+}
+
+Material make_material(const MaterialDescription& d, const std::string& what) {
+    require_non_negative(d.ka, what + ".ka");
+    require_non_negative(d.kd, what + ".kd");
+    require_non_negative(d.ks, what + ".ks");
+    require_non_negative(d.km, what + ".km");
+    if (!(d.p.value > 0)) fail(d.p.where, what + ".p: the specular exponent must be > 0");
+    return {d.ka.value, d.kd.value, d.ks.value, d.p.value, d.km.value, d.highlight.value};
+}
+
+class SceneBuilder {
+public:
+    SceneBuilder(const SceneDescription& description, Scene& scene) : m_description(description), m_scene(scene) {
+        for (const auto& material : description.materials) {
+            m_material_index[material.name] = static_cast<uint32_t>(scene.materials.size());
+            scene.materials.push_back(make_material(material, "materials." + material.name));
+            m_material_names.push_back(material.name);
+        }
+    }
+
+    void add_objects(const std::vector<ObjectDescription>& objects, const Transform& parent) {
+        for (const auto& object : objects) add_object(object, parent);
+    }
+
+private:
+    uint32_t resolve_material(const ObjectDescription& object) {
+        const std::string kind = to_string(object.type);
+        if (!object.material) fail(object.where, kind + ": missing required key 'material'");
+        const MaterialReference& reference = *object.material;
+        if (reference.inline_) {
+            m_scene.materials.push_back(make_material(*reference.inline_, kind + ".material"));
+            return static_cast<uint32_t>(m_scene.materials.size() - 1);
+        }
+        const auto it = m_material_index.find(reference.name);
+        if (it == m_material_index.end()) {
+            std::string known;
+            for (const auto& name : m_material_names) known += (known.empty() ? "" : ", ") + name;
+            fail(reference.where, kind + ": unknown material '" + reference.name + "'" +
+                                      did_you_mean(reference.name, m_material_names) +
+                                      (known.empty() ? "; the scene defines no materials" : "; defined: " + known));
+        }
+        return it->second;
+    }
+
+    void add_object(const ObjectDescription& object, const Transform& parent) {
+        for (const TransformStep& step : object.transform) check_step(step);
+        const Transform to_world = make_transform(object.transform).then(parent);
+        if (!(std::fabs(to_world.determinant()) > 1e-300))
+            fail(object.transform.empty() ? object.where : object.transform.front().where,
+                 "the transform is singular (it flattens the object)");
+        switch (object.type) {
+            case ObjectType::sphere: {
+                if (!(object.radius.value > 0)) fail(object.radius.where, "sphere.radius must be > 0");
+                m_scene.spheres.push_back(
+                    {to_world, object.center.value, object.radius.value, resolve_material(object)});
+                break;
+            }
+            case ObjectType::plane: {
+                require_non_zero(object.normal, "plane.normal");
+                const Vec3 normal = normalize(to_world.apply_normal(object.normal.value));
+                m_scene.planes.push_back({to_world.apply_point(object.point.value), normal, resolve_material(object)});
+                break;
+            }
+            case ObjectType::box: {
+                const Vec3 lo = object.min.value, hi = object.max.value;
+                if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z))
+                    fail(object.max.where, "box: min must be less than max on every axis (min " + format(lo) +
+                                               ", max " + format(hi) + ")");
+                m_scene.boxes.push_back({to_world, lo, hi, resolve_material(object)});
+                break;
+            }
+            case ObjectType::triangle: {
+                TriangleMesh mesh;
+                mesh.material = resolve_material(object);
+                for (const Vec3& v : object.vertices) push_position(mesh, to_world.apply_point(v));
+                mesh.indices = {0, 1, 2};
+                m_scene.meshes.push_back(std::move(mesh));
+                break;
+            }
+            case ObjectType::mesh:
+                if (object.file.given)
+                    add_mesh_file(object, to_world);
+                else
+                    add_inline_mesh(object, to_world);
+                break;
+            case ObjectType::group:
+                add_objects(object.children, to_world);
+                break;
+        }
+    }
+
+    void add_inline_mesh(const ObjectDescription& object, const Transform& to_world) {
+        const size_t n = object.vertices.size();
+        if (n < 3) fail(object.vertices_where, "mesh.vertices: a mesh needs at least 3 vertices");
+        if (object.triangles.empty())
+            fail(object.triangles_where, "mesh.triangles: a mesh needs at least one triangle");
+        if (!object.normals.empty() && object.normals.size() != n)
+            fail(object.normals_where, "mesh.normals: " + std::to_string(object.normals.size()) + " normals for " +
+                                           std::to_string(n) + " vertices; give one per vertex");
+        TriangleMesh mesh;
+        mesh.material = resolve_material(object);
+        for (const Vec3& v : object.vertices) push_position(mesh, to_world.apply_point(v));
+        for (size_t t = 0; t < object.triangles.size(); ++t)
+            for (const int64_t index : object.triangles[t]) {
+                if (index < 0 || index >= static_cast<int64_t>(n))
+                    fail(object.triangle_where[t], "mesh.triangles[" + std::to_string(t) + "]: vertex index " +
+                                                       std::to_string(index) + " is out of range (0.." +
+                                                       std::to_string(n - 1) + ")");
+                mesh.indices.push_back(static_cast<uint32_t>(index));
+            }
+        for (size_t i = 0; i < object.normals.size(); ++i) {
+            if (is_zero(object.normals[i]))
+                fail(object.normals_where, "mesh.normals[" + std::to_string(i) + "] must not be the zero vector");
+            push_normal(mesh, to_world.apply_normal(object.normals[i]));
+        }
+        m_scene.meshes.push_back(std::move(mesh));
+    }
+
+    void add_mesh_file(const ObjectDescription& object, const Transform& to_world) {
+        MeshData data = load_obj_mesh(object.file_path, object.file.where);
+        TriangleMesh mesh;
+        if (object.material) {
+            mesh.material = resolve_material(object);
+        } else {
+            std::vector<uint32_t> mtl_index;
+            for (size_t i = 0; i < data.materials.size(); ++i) {
+                mtl_index.push_back(static_cast<uint32_t>(m_scene.materials.size()));
+                m_scene.materials.push_back(
+                    make_material(data.materials[i], object.file_path + ": material '" + data.materials[i].name + "'"));
+            }
+            for (const int32_t m : data.triangle_material) {
+                if (m < 0)
+                    fail(object.where,
+                         "mesh: '" + object.file.value +
+                             "' has faces without an MTL material (usemtl), and the object has no 'material'");
+                mesh.triangle_materials.push_back(mtl_index[m]);
+            }
+        }
+        const size_t n = data.positions.size() / 3;
+        mesh.positions.reserve(4 * n);
+        for (size_t i = 0; i < n; ++i)
+            push_position(mesh, to_world.apply_point(
+                                    {data.positions[3 * i], data.positions[3 * i + 1], data.positions[3 * i + 2]}));
+        if (!data.normals.empty()) {
+            mesh.normals.reserve(3 * n);
+            for (size_t i = 0; i < n; ++i)
+                push_normal(mesh, to_world.apply_normal(
+                                      {data.normals[3 * i], data.normals[3 * i + 1], data.normals[3 * i + 2]}));
+        }
+        mesh.indices = std::move(data.indices);
+        m_scene.meshes.push_back(std::move(mesh));
+    }
+
+    static void push_position(TriangleMesh& mesh, const Vec3& p) {
+        mesh.positions.insert(mesh.positions.end(), {float(p.x), float(p.y), float(p.z), 0.0f});
+    }
+    static void push_normal(TriangleMesh& mesh, const Vec3& n) {
+        // A zero normal from the file (rare) stays zero; shading then falls back to the face normal.
+        const double len = length(n);
+        const Vec3 unit = len > 0 ? n / len : Vec3();
+        mesh.normals.insert(mesh.normals.end(), {float(unit.x), float(unit.y), float(unit.z)});
+    }
+
+    static void check_step(const TransformStep& step) {
+        switch (step.kind) {
+            case TransformStep::Kind::scale:
+                if (step.vector.x == 0 || step.vector.y == 0 || step.vector.z == 0)
+                    fail(step.where, "transform: a scale factor of 0 flattens the object");
+                break;
+            case TransformStep::Kind::rotate:
+                if (is_zero(step.vector)) fail(step.where, "transform: the rotation axis must not be the zero vector");
+                break;
+            case TransformStep::Kind::translate:
+                break;
+            case TransformStep::Kind::matrix: {
+                const auto& m = step.matrix;
+                if (m[12] != 0 || m[13] != 0 || m[14] != 0 || m[15] != 1)
+                    fail(step.where, "transform.matrix: the last row must be 0 0 0 1 (affine transforms only)");
+                break;
+            }
+        }
+    }
+
+    static std::string format(const Vec3& v) {
+        char buffer[96];
+        std::snprintf(buffer, sizeof buffer, "[%g, %g, %g]", v.x, v.y, v.z);
+        return buffer;
+    }
+
+    const SceneDescription& m_description;
+    Scene& m_scene;
+    std::unordered_map<std::string, uint32_t> m_material_index;
+    std::vector<std::string> m_material_names;
+};
+
+}  // namespace
+
+size_t Scene::triangle_count() const {
+    size_t n = 0;
+    for (const auto& mesh : meshes) n += mesh.triangle_count();
+    return n;
+}
+
+Transform make_transform(const std::vector<TransformStep>& steps) {
+    Transform result;
+    for (const TransformStep& step : steps) {
+        switch (step.kind) {
+            case TransformStep::Kind::scale:
+                result = result.then(Transform::scale(step.vector));
+                break;
+            case TransformStep::Kind::rotate:
+                result = result.then(Transform::rotate(step.vector, step.angle));
+                break;
+            case TransformStep::Kind::translate:
+                result = result.then(Transform::translate(step.vector));
+                break;
+            case TransformStep::Kind::matrix: {
+                const auto& m = step.matrix;
+                if (std::fabs(linear_determinant(
+                        {m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9], m[10], m[11]})) <= 1e-300)
+                    throw InputError(step.where, "transform.matrix is singular");
+                result = result.then(
+                    Transform::from_rows({m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9], m[10], m[11]}));
+                break;
+            }
+        }
+    }
+    return result;
+}
+
+Camera make_camera(const CameraDescription& d, int width, int height) {
+    const Vec3 view = d.look_at.value - d.eye.value;
+    if (is_zero(view)) fail(d.look_at.where, "camera: look_at must differ from eye");
+    if (is_zero(d.up.value)) fail(d.up.where, "camera.up must not be the zero vector");
+    const Vec3 forward = normalize(view);
+    const Vec3 side = cross(forward, d.up.value);
+    if (length(side) <= 1e-9 * length(d.up.value))
+        fail(d.up.where, "camera.up is parallel to the view direction (eye → look_at); pick another up");
+    // The same construction as POV-Ray's camera with `right -x*W/H`, `sky up` (pov-model.md §4):
+    // screen right = normalize(forward × up), screen up = forward × normalize(up × forward).
+    const Vec3 right_unit = normalize(side);
+    const Vec3 up_unit = cross(forward, normalize(cross(d.up.value, forward)));
+    const double aspect = double(width) / double(height);
+    Camera camera;
+    camera.type = d.type.value;
+    camera.eye = d.eye.value;
+    if (d.type.value == CameraType::perspective) {
+        if (!(d.fov.value > 0 && d.fov.value < 180))
+            fail(d.fov.where,
+                 "camera.fov must be between 0 and 180 degrees (exclusive), got " + std::to_string(d.fov.value));
+        const double direction_length = aspect / (2.0 * std::tan(d.fov.value * std::numbers::pi / 360.0));
+        camera.forward = forward * direction_length;
+        camera.right = right_unit * aspect;
+        camera.up = up_unit;
+    } else {
+        if (!(d.view_width.value > 0)) fail(d.view_width.where, "camera.view_width must be > 0");
+        camera.forward = forward;
+        camera.right = right_unit * d.view_width.value;
+        camera.up = up_unit * (d.view_width.value / aspect);
+    }
+    return camera;
+}
+
+Scene validate_scene(const SceneDescription& d) {
+    Scene scene;
+    scene.path = d.path;
+    const auto& image = d.image;
+    if (image.width.value < 1) fail(image.width.where, "image.width must be at least 1");
+    if (image.height.value < 1) fail(image.height.where, "image.height must be at least 1");
+    if (image.width.value > limits::max_image_side || image.height.value > limits::max_image_side ||
+        image.width.value * image.height.value > limits::max_image_pixels)
+        fail(image.width.where, "image is " + std::to_string(image.width.value) + "x" +
+                                    std::to_string(image.height.value) + "; the limit is " +
+                                    std::to_string(limits::max_image_side) + " per side and " +
+                                    std::to_string(limits::max_image_pixels) + " pixels");
+    if (image.samples.value < 1 || image.samples.value > limits::max_samples)
+        fail(image.samples.where, "image.samples must be between 1 and " + std::to_string(limits::max_samples));
+    require_non_negative(image.background, "image.background");
+    if (d.max_depth.value < 1 || d.max_depth.value > limits::max_depth)
+        fail(d.max_depth.where, "render.max_depth must be between 1 and " + std::to_string(limits::max_depth));
+    require_non_negative(d.ambient, "ambient");
+    scene.width = static_cast<int>(image.width.value);
+    scene.height = static_cast<int>(image.height.value);
+    scene.samples = static_cast<int>(image.samples.value);
+    scene.max_depth = static_cast<int>(d.max_depth.value);
+    scene.background = image.background.value;
+    scene.ambient = d.ambient.value;
+    scene.camera = make_camera(d.camera, scene.width, scene.height);
+
+    for (size_t i = 0; i < d.lights.size(); ++i) {
+        const LightDescription& light = d.lights[i];
+        const std::string what = "lights[" + std::to_string(i) + "]";
+        require_non_negative(light.intensity, what + ".intensity");
+        Light out;
+        out.type = light.type;
+        out.intensity = light.intensity.value;
+        if (light.type == LightType::point) {
+            out.position = light.position.value;
+        } else {
+            require_non_zero(light.direction, what + ".direction");
+            out.toward_light = -normalize(light.direction.value);
+        }
+        scene.lights.push_back(out);
+    }
+
+    SceneBuilder builder(d, scene);
+    builder.add_objects(d.objects, Transform());
+    if (static_cast<int64_t>(scene.triangle_count()) > limits::max_triangles)
+        throw InputError({d.path}, "the scene has " + std::to_string(scene.triangle_count()) +
+                                       " triangles; the limit is " + std::to_string(limits::max_triangles));
+    return scene;
+}
+
+}  // namespace whitted
