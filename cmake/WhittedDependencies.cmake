@@ -12,6 +12,8 @@ find_package(CLI11 CONFIG REQUIRED)
 find_package(fmt CONFIG REQUIRED)
 find_package(nlohmann_json CONFIG REQUIRED)
 find_package(OpenImageIO CONFIG REQUIRED)
+find_package(OpenEXR CONFIG REQUIRED)
+find_package(Imath CONFIG REQUIRED)
 
 # Quirk A: Debian built OpenImageIO with OpenCV, and its exported target names
 # /usr/include/opencv4, which does not exist unless libopencv-dev (+417 MB) is installed.

@@ -3,7 +3,15 @@
 
 #include "whitted/output/color_management.h"
 
-#include <OpenImageIO/imageio.h>
+#include "whitted/output/plugin.h"
+
+#include <Imath/half.h>
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfThreading.h>
 
 #include <unistd.h>
 
@@ -13,6 +21,7 @@
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
+#include <thread>
 
 namespace whitted {
 namespace {
@@ -72,38 +81,72 @@ void check_output_path(const std::string& path) {
         throw std::invalid_argument("cannot write '" + path + "': it is a directory");
 }
 
+/// The plug-in's writer for display-referred files (8/16-bit PNG/JPEG/TIFF); see plugin.h.
+using WriteDisplayImage = std::string (*)(const std::string& format_path, const std::string& temp_path, int width,
+                                          int height, const float* rgb, int bits,
+                                          const std::vector<std::pair<std::string, std::string>>& metadata);
+
+namespace {
+
+void write_exr(const Image& image, const std::string& temp_path, bool half,
+               const std::vector<std::pair<std::string, std::string>>& metadata) {
+    // OpenEXR directly (not through OpenImageIO) keeps EXR renders free of OpenImageIO's
+    // start-up cost; ZIP blocks are compressed on all cores.
+    Imf::setGlobalThreadCount(int(std::thread::hardware_concurrency()));
+    Imf::Header header(image.width, image.height);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    const Imf::PixelType type = half ? Imf::HALF : Imf::FLOAT;
+    for (const char* channel : {"R", "G", "B"}) header.channels().insert(channel, Imf::Channel(type));
+    for (const auto& [key, value] : metadata) header.insert(key, Imf::StringAttribute(value));
+    std::vector<Imath::half> halves;
+    const char* base = reinterpret_cast<const char*>(image.rgb.data());
+    size_t element = sizeof(float);
+    if (half) {
+        halves.assign(image.rgb.begin(), image.rgb.end());
+        base = reinterpret_cast<const char*>(halves.data());
+        element = sizeof(Imath::half);
+    }
+    Imf::FrameBuffer frame;
+    const char* names[] = {"R", "G", "B"};
+    for (int c = 0; c < 3; ++c)
+        frame.insert(names[c], Imf::Slice(type, const_cast<char*>(base + c * element), 3 * element,
+                                          3 * element * size_t(image.width)));
+    try {
+        Imf::OutputFile file(temp_path.c_str(), header);
+        file.setFrameBuffer(frame);
+        file.writePixels(image.height);
+    } catch (const std::exception& e) {
+        throw std::runtime_error(std::string("cannot write the EXR file: ") + e.what());
+    }
+}
+
+}  // namespace
+
 void write_image(const Image& image, const std::string& path, const OutputOptions& options) {
     const OutputKind kind = output_kind(path);
     const std::string ext = lower_extension(path);
-    std::vector<float> pixels = image.rgb;
-    OIIO::TypeDesc type = OIIO::TypeDesc::FLOAT;
-    std::string colorspace = "Linear Rec.709 (sRGB)";
+    std::vector<std::pair<std::string, std::string>> metadata{{"Software", "Whitted 0.1.0"}};
+    metadata.insert(metadata.end(), options.metadata.begin(), options.metadata.end());
+
+    TemporaryFile temporary(path);
     if (kind == OutputKind::linear_exr) {
-        if (options.half) type = OIIO::TypeDesc::HALF;
+        metadata.push_back({"whitted:colorspace", "Linear Rec.709 (sRGB), scene-referred"});
+        write_exr(image, temporary.path(), options.half, metadata);
     } else {
+        std::vector<float> pixels = image.rgb;
         const DisplayTransform display(options.ocio_config, options.display, options.view);
         display.apply(pixels.data(), pixels.size() / 3);
         const bool is_tiff = ext == ".tif" || ext == ".tiff";
-        int bits = options.bit_depth ? options.bit_depth : (is_tiff ? 16 : 8);
+        const int bits = options.bit_depth ? options.bit_depth : (is_tiff ? 16 : 8);
         if ((ext == ".jpg" || ext == ".jpeg") && bits != 8)
             throw std::invalid_argument("JPEG files hold 8 bits per channel only");
-        type = bits == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8;
-        colorspace = display.display() + " / " + display.view() + " (" + display.config_source() + ")";
+        metadata.push_back(
+            {"whitted:colorspace", display.display() + " / " + display.view() + " (" + display.config_source() + ")"});
+        const auto write = reinterpret_cast<WriteDisplayImage>(image_io_plugin_symbol("whitted_write_display_image"));
+        const std::string error =
+            write(path, temporary.path(), image.width, image.height, pixels.data(), bits, metadata);
+        if (!error.empty()) throw std::runtime_error("cannot write '" + path + "': " + error);
     }
-
-    OIIO::ImageSpec spec(image.width, image.height, 3, type);
-    spec.attribute("Software", "Whitted");
-    spec.attribute("whitted:colorspace", colorspace);
-    if (kind == OutputKind::linear_exr) spec.attribute("compression", "zip");
-    for (const auto& [key, value] : options.metadata) spec.attribute(key, value);
-
-    TemporaryFile temporary(path);
-    auto out = OIIO::ImageOutput::create(path);
-    if (!out) throw std::runtime_error("cannot write '" + path + "': " + OIIO::geterror());
-    if (!out->open(temporary.path(), spec)) throw std::runtime_error("cannot write '" + path + "': " + out->geterror());
-    const bool wrote = out->write_image(OIIO::TypeDesc::FLOAT, pixels.data());
-    const bool closed = out->close();
-    if (!wrote || !closed) throw std::runtime_error("cannot write '" + path + "': " + out->geterror());
     temporary.commit(path);
 }
 

@@ -1,0 +1,59 @@
+// SPDX-License-Identifier: MIT
+#include "whitted/output/plugin.h"
+
+#include <dlfcn.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <mutex>
+#include <stdexcept>
+#include <vector>
+
+namespace whitted {
+namespace {
+
+constexpr const char* plugin_file = "libwhitted_oiio.so";
+
+void* load_plugin() {
+    std::vector<std::filesystem::path> candidates;
+    if (const char* dir = std::getenv("WHITTED_PLUGIN_DIR"); dir && *dir) candidates.emplace_back(dir);
+    std::error_code error;
+    const auto exe = std::filesystem::read_symlink("/proc/self/exe", error);
+    if (!error) candidates.push_back(exe.parent_path().parent_path() / "lib");
+#ifdef WHITTED_BUILD_PLUGIN_DIR
+    candidates.emplace_back(WHITTED_BUILD_PLUGIN_DIR);
+#endif
+    std::string tried;
+    for (const auto& dir : candidates) {
+        const std::filesystem::path path = dir / plugin_file;
+        if (!std::filesystem::exists(path, error)) {
+            tried += "\n  " + path.string() + " (not found)";
+            continue;
+        }
+        if (void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)) return handle;
+        tried += "\n  " + path.string() + " (" + dlerror() + ")";
+    }
+    throw std::runtime_error(std::string("cannot load the OpenImageIO plug-in ") + plugin_file +
+                             " (needed for PNG/JPEG/TIFF and `whitted check`); tried:" + tried);
+}
+
+}  // namespace
+
+void* image_io_plugin_symbol(const char* name) {
+    static std::once_flag once;
+    static void* handle = nullptr;
+    static std::string load_error;
+    std::call_once(once, [] {
+        try {
+            handle = load_plugin();
+        } catch (const std::exception& e) {
+            load_error = e.what();
+        }
+    });
+    if (!handle) throw std::runtime_error(load_error);
+    void* symbol = dlsym(handle, name);
+    if (!symbol) throw std::runtime_error(std::string("the OpenImageIO plug-in has no '") + name + "'");
+    return symbol;
+}
+
+}  // namespace whitted
