@@ -83,9 +83,14 @@ void analytic_occluded(const RTCOccludedFunctionNArguments* args) {
         ray->tfar = -INFINITY;  // Embree's mark for "occluded"
 }
 
-void report_embree_error(void*, RTCError code, const char* message) {
-    if (code == RTC_ERROR_NONE) return;
-    throw std::runtime_error(std::string("Embree error: ") + (message ? message : "unknown"));
+/// Embree calls this from C code, where an exception must not pass: keep the first message
+/// and throw after the Embree call returns (check_embree).
+void record_embree_error(void* user, RTCError code, const char* message) {
+    auto* first_error = static_cast<std::string*>(user);
+    if (code != RTC_ERROR_NONE && first_error->empty())
+        *first_error = code == RTC_ERROR_OUT_OF_MEMORY
+                           ? "out of memory while building the BVH"
+                           : std::string("Embree: ") + (message ? message : "unknown error");
 }
 
 RTCRay make_embree_ray(const Ray& ray) {
@@ -119,6 +124,7 @@ Vec3 vertex_normal(const TriangleMesh& mesh, uint32_t index) {
 
 struct Accelerator::Impl {
     const Scene& scene;
+    std::string embree_error;  ///< first error Embree reported (see record_embree_error)
     RTCDevice device = nullptr;
     RTCScene rtc_scene = nullptr;
     // geomID → what it is: a mesh index, or the sphere/box user geometry.
@@ -131,18 +137,28 @@ struct Accelerator::Impl {
         spheres.scene = boxes.scene = &scene;
         device = rtcNewDevice("verbose=0");
         if (!device) throw std::runtime_error("cannot create the Embree device");
-        rtcSetDeviceErrorFunction(device, report_embree_error, nullptr);
+        rtcSetDeviceErrorFunction(device, record_embree_error, &embree_error);
         rtc_scene = rtcNewScene(device);
-        rtcSetSceneBuildQuality(rtc_scene, RTC_BUILD_QUALITY_HIGH);
+        // Medium quality: for 1M triangles HIGH took 2.0 s to build against 0.2 s, for a few
+        // percent faster traversal that a single frame cannot win back.
+        rtcSetSceneBuildQuality(rtc_scene, RTC_BUILD_QUALITY_MEDIUM);
         for (uint32_t m = 0; m < scene.meshes.size(); ++m) add_mesh(m);
         if (!scene.spheres.empty()) add_analytic(spheres, scene.spheres.size());
         if (!scene.boxes.empty()) add_analytic(boxes, scene.boxes.size());
         rtcCommitScene(rtc_scene);
+        if (!embree_error.empty()) {
+            release();
+            throw std::runtime_error(embree_error);
+        }
     }
 
-    ~Impl() {
+    ~Impl() { release(); }
+
+    void release() {
         if (rtc_scene) rtcReleaseScene(rtc_scene);
         if (device) rtcReleaseDevice(device);
+        rtc_scene = nullptr;
+        device = nullptr;
     }
 
     void add_mesh(uint32_t m) {
