@@ -138,13 +138,13 @@ struct SceneDescription {
 namespace limits {
 inline constexpr int64_t max_image_side = 65536;
 inline constexpr int64_t max_image_pixels = int64_t(1) << 28;  // 268 M pixels
-inline constexpr int64_t max_samples = 64;
+inline constexpr int64_t max_samples = 16;                     // 256 rays per pixel
 inline constexpr int64_t max_depth = 256;
 inline constexpr int max_nesting = 64;  ///< groups inside groups
 inline constexpr int64_t max_scene_file_bytes = int64_t(256) << 20;
 inline constexpr int64_t max_mesh_file_bytes = int64_t(2) << 30;
 inline constexpr int64_t max_triangles = int64_t(64) << 20;  // 67 M triangles
-inline constexpr int64_t max_yaml_nodes = 50'000'000;        ///< stops alias ("billion laughs") bombs
+inline constexpr int64_t max_yaml_nodes = 10'000'000;        ///< stops alias ("billion laughs") bombs
 }  // namespace limits
 
 /// Reads a scene file (YAML or JSON). Throws InputError naming file:line:col on any problem.

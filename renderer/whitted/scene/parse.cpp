@@ -569,6 +569,20 @@ const char* to_string(ObjectType type) {
     return "object";
 }
 
+/// yaml-cpp's messages are terse; say what usually causes them.
+static std::string syntax_hint(const std::string& text, int line) {
+    size_t begin = 0;
+    for (int l = 0; l < line && begin != std::string::npos; ++l) {
+        begin = text.find('\n', begin);
+        if (begin != std::string::npos) ++begin;
+    }
+    for (size_t i = begin; i != std::string::npos && i < text.size() && (text[i] == ' ' || text[i] == '\t'); ++i)
+        if (text[i] == '\t') return " (a tab in the indentation: YAML indents with spaces only)";
+    if (text.find("[[[[[[[[[[") != std::string::npos || text.find("{{{{{{{{{{") != std::string::npos)
+        return " (values nested too deeply)";
+    return "";
+}
+
 SceneDescription parse_scene_text(const std::string& text, const std::string& path) {
     ParseContext ctx;
     ctx.file = path;
@@ -578,7 +592,8 @@ SceneDescription parse_scene_text(const std::string& text, const std::string& pa
     try {
         root = YAML::Load(text);
     } catch (const YAML::ParserException& e) {
-        throw InputError({path, e.mark.line + 1, e.mark.column + 1}, "syntax error: " + e.msg);
+        throw InputError({path, e.mark.line + 1, e.mark.column + 1},
+                         "syntax error: " + e.msg + syntax_hint(text, e.mark.line));
     } catch (const YAML::Exception& e) {
         throw InputError({path, e.mark.is_null() ? 0 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1},
                          std::string("cannot read the scene: ") + e.msg);
