@@ -1,10 +1,209 @@
 // SPDX-License-Identifier: MIT
+// `whitted check`: one scene rendered by Whitted and, converted, by POV-Ray 3.7, compared
+// pixel by pixel (docs/validation.md explains the method and the tolerance).
+
 #include "reference/check.h"
 
+#include "converters/pov_writer.h"
+#include "reference/povray.h"
+#include "whitted/render/accelerator.h"
+#include "whitted/render/renderer.h"
+#include "whitted/scene/description.h"
+#include "whitted/scene/scene.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <optional>
 #include <stdexcept>
 
 namespace whitted::reference {
-CheckResult run_check(const std::string&, const CheckOptions&) {
-    throw std::runtime_error("whitted check: not implemented yet");
+namespace {
+
+namespace fs = std::filesystem;
+
+// Fixed names inside the work directory: the scene's own name may hold characters that a
+// POV-Ray .ini cannot, and a report directory then always looks the same.
+constexpr const char* pov_name = "scene.pov";
+constexpr const char* ini_name = "scene.ini";
+constexpr const char* povray_image_name = "povray-16bit.png";
+
+/// POV-Ray clipped values above 1 into code 65535; this many times at most it is run again at
+/// half the exposure before the comparison is made anyway (and then shows the clipping).
+constexpr int max_exposure_retries = 8;
+
+double max_value(const Image& image) {
+    double m = 0;
+    for (const float v : image.rgb)
+        if (double(v) > m) m = v;  // NaN compares false and is left to the comparison to report
+    return m;
 }
+
+/// The largest power of two ≤ 1 that brings `m` into [0, 1]: a power of two scales every float
+/// exactly, so ours×exposure carries no rounding of its own.
+double exposure_for(double m) {
+    // An infinite value is a bug the comparison will show; it must not darken POV-Ray to black.
+    if (!std::isfinite(m)) return 1.0;
+    return m > 1 ? std::exp2(-std::ceil(std::log2(m))) : 1.0;
+}
+
+Image scaled(const Image& image, double factor) {
+    Image out = image;
+    if (factor != 1)
+        for (float& v : out.rgb) v = float(double(v) * factor);
+    return out;
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+    out.close();
+    if (!out) throw std::runtime_error("cannot write '" + path.string() + "'");
+}
+
+/// Whether POV-Ray's 16-bit PNG clipped a value that is not 1 in our image: a code of 65535
+/// under a pixel where ours (at this exposure) is clearly below 1. With image.samples > 1 a
+/// single sub-sample may exceed 1 while the block average does not, so this is checked on
+/// POV-Ray's full-resolution image.
+bool povray_clipped(const Image& full, const Image& ours, int n, double exposure, double tolerance) {
+    for (int y = 0; y < full.height; ++y)
+        for (int x = 0; x < full.width; ++x) {
+            const float* p = full.pixel(x, y);
+            const float* o = ours.pixel(x / n, y / n);
+            for (int ch = 0; ch < 3; ++ch)
+                if (p[ch] >= 1.0f && double(o[ch]) * exposure < 1.0 - tolerance) return true;
+        }
+    return false;
+}
+
+std::string codes(double value) {
+    return fmt::format("{:.1f}", value * 65535.0);
+}
+
+std::string rgb_text(const float* v) {
+    return fmt::format("{:.6f} {:.6f} {:.6f}", v[0], v[1], v[2]);
+}
+
+std::string rgb_codes(const float* v) {
+    return fmt::format("{:.1f} {:.1f} {:.1f}", double(v[0]) * 65535.0, double(v[1]) * 65535.0, double(v[2]) * 65535.0);
+}
+
+void print_table(const std::string& scene_path, const CheckResult& r, const CheckOptions& options) {
+    const ImageComparison& c = r.comparison;
+    std::string out;
+    out +=
+        fmt::format("whitted check {}: {}x{}, {} sample(s)/pixel, compared at exposure {:g}{}\n", scene_path, c.width,
+                    c.height, r.samples * r.samples, r.exposure, r.exposure != 1 ? " (scene values above 1)" : "");
+    out += fmt::format("  Whitted {:.3f}s, POV-Ray {:.2f}s ({} run{}, {})\n", r.whitted_seconds, r.povray_seconds,
+                       r.povray_runs, r.povray_runs == 1 ? "" : "s", r.povray_program);
+    out += fmt::format("  max error    {:.3e}  ({} codes of 65535)\n", c.max_error, codes(c.max_error));
+    out +=
+        fmt::format("  mean error   {:.3e}  ({} codes)\n", c.mean_error, fmt::format("{:.3f}", c.mean_error * 65535));
+    out += fmt::format("  RMS error    {:.3e}  ({} codes)\n", c.rms_error, fmt::format("{:.3f}", c.rms_error * 65535));
+    out += std::isinf(c.psnr) ? std::string("  PSNR         inf (identical)\n")
+                              : fmt::format("  PSNR         {:.1f} dB (peak 1)\n", c.psnr);
+    out += fmt::format("  within {:g}/65535: {} ({} of {} pixels; {:g}% required)\n", options.tolerance * 65535,
+                       format_percent(c), c.pixels_within, c.pixels, options.required_fraction * 100);
+    out += fmt::format("  worst pixel  ({}, {}): Whitted {}  POV-Ray {}\n", c.worst_x, c.worst_y,
+                       rgb_text(c.worst_ours), rgb_text(c.worst_theirs));
+    out += fmt::format("               in codes: Whitted {}  POV-Ray {}\n", rgb_codes(c.worst_ours),
+                       rgb_codes(c.worst_theirs));
+    if (!options.report_dir.empty())
+        out += "  report       " + (fs::path(options.report_dir) / "report.html").string() + "\n";
+    std::fputs(out.c_str(), stdout);
+}
+
+}  // namespace
+
+std::string verdict_line(const std::string& scene_path, const CheckResult& r, const CheckOptions& options) {
+    return fmt::format("{} {}: {} of pixels within {:g}/65535 (max {} codes)", r.passed ? "PASS" : "FAIL", scene_path,
+                       format_percent(r.comparison), options.tolerance * 65535, codes(r.comparison.max_error));
+}
+
+CheckResult run_check(const std::string& scene_path, const CheckOptions& options) {
+    CheckResult result;
+
+    // 1. Whitted, exactly as `whitted render` does it.
+    const SceneDescription description = parse_scene_file(scene_path);
+    const Scene scene = validate_scene(description);
+    Image ours;
+    {
+        const Accelerator accelerator(scene);
+        RenderOptions render_options;
+        render_options.threads = options.threads;
+        RenderResult rendered = render(scene, accelerator, render_options);
+        result.whitted_seconds = rendered.seconds;
+        ours = std::move(rendered.image);
+    }
+    result.samples = scene.samples;
+    const int n = scene.samples;
+
+    // 2. Where POV-Ray's files go: the report directory (kept), else a temporary one.
+    std::optional<TemporaryDirectory> temporary;
+    fs::path work;
+    if (!options.report_dir.empty()) {
+        work = options.report_dir;
+        std::error_code error;
+        fs::create_directories(work, error);
+        if (error || !fs::is_directory(work))
+            throw std::runtime_error("cannot create the report directory '" + work.string() +
+                                     "': " + (error ? error.message() : "not a directory"));
+    } else {
+        temporary.emplace("whitted-check-");
+        work = temporary->path();
+    }
+    result.pov_file = pov_name;
+    result.ini_file = ini_name;
+    result.povray_image = povray_image_name;
+
+    // 3. POV-Ray, always into a linear 16-bit PNG (1/65535 steps): scenes brighter than 1 are
+    // darkened by a power of two (lights, ambient light and background; the image is linear in
+    // them) instead of using POV-Ray's half-float EXR, whose steps are 2^-11 relative.
+    double exposure = exposure_for(max_value(ours));
+    Image theirs_full;
+    for (int attempt = 0;; ++attempt) {
+        pov::ConvertOptions convert;
+        convert.exposure = exposure;
+        convert.hdr_output = false;
+        write_text(work / pov_name, pov::scene_to_sdl(description, convert));
+        write_text(work / ini_name, pov::ini_for(description, pov_name, povray_image_name, convert));
+        std::error_code ignored;
+        fs::remove(work / povray_image_name, ignored);  // never read a previous run's image
+
+        const PovrayRun run = run_povray((work / ini_name).string(),
+                                         options.report_dir.empty() ? std::string() : (work / "povray.log").string());
+        result.povray_program = run.program;
+        result.povray_seconds += run.seconds;
+        ++result.povray_runs;
+        if (!fs::exists(work / povray_image_name))
+            throw std::runtime_error("POV-Ray finished but wrote no '" + (work / povray_image_name).string() +
+                                     "'; its last words:\n" +
+                                     run.log.substr(run.log.size() > 2000 ? run.log.size() - 2000 : 0));
+        theirs_full = read_linear_image((work / povray_image_name).string());
+        if (theirs_full.width != ours.width * n || theirs_full.height != ours.height * n)
+            throw std::runtime_error(fmt::format("POV-Ray wrote a {}x{} image; expected {}x{}", theirs_full.width,
+                                                 theirs_full.height, ours.width * n, ours.height * n));
+        if (attempt == max_exposure_retries || !povray_clipped(theirs_full, ours, n, exposure, options.tolerance))
+            break;
+        exposure *= 0.5;
+    }
+    result.exposure = exposure;
+
+    // 4. The comparison, at the exposure POV-Ray rendered with.
+    const Image theirs = downsample_box(theirs_full, n);
+    const Image ours_exposed = scaled(ours, exposure);
+    result.comparison = compare_images(ours_exposed, theirs, options.tolerance);
+    result.passed = result.comparison.fraction_within() >= options.required_fraction;
+
+    if (!options.quiet) print_table(scene_path, result, options);
+    if (!options.report_dir.empty())
+        write_report(options.report_dir, scene_path, ours_exposed, theirs, result, options);
+    std::printf("%s\n", verdict_line(scene_path, result, options).c_str());
+    std::fflush(stdout);
+    return result;
+}
+
 }  // namespace whitted::reference

@@ -19,15 +19,26 @@ struct CheckResult {
     ImageComparison comparison;
     double exposure = 1;  ///< the scale both images were compared at (< 1 for scenes brighter than 1)
     bool passed = false;
+    int samples = 1;  ///< image.samples: POV-Ray rendered samples×W by samples×H
+    double whitted_seconds = 0, povray_seconds = 0;
+    int povray_runs = 0;                           ///< more than 1 when POV-Ray clipped and was run again darker
+    std::string povray_program;                    ///< the povray that ran
+    std::string pov_file, ini_file, povray_image;  ///< file names inside the work (report) directory
 };
 
 /// Renders the scene with Whitted and (converted) with POV-Ray, compares them, prints the
 /// figures and writes the report. Throws InputError / std::runtime_error on errors.
 CheckResult run_check(const std::string& scene_path, const CheckOptions& options);
 
-/// Writes ours.png, povray.png, diff.png (scaled heat map), ours.exr, povray.exr, metrics.json
-/// and report.html into `dir`.
+/// Writes ours.png, povray.png, diff.png (scaled heat map), ours.exr, povray.exr, diff.exr,
+/// metrics.json and report.html into `dir`. `ours` and `theirs` are the images as compared,
+/// i.e. already multiplied by result.exposure; the EXRs are written at the scene's own scale
+/// (ours.exr is what `whitted render` writes), the PNGs and the heat map at the compared scale.
 void write_report(const std::string& dir, const std::string& scene_path, const Image& ours, const Image& theirs,
                   const CheckResult& result, const CheckOptions& options);
+
+/// The one-line verdict printed last by `whitted check` (scripts/validate reads it), e.g.
+/// "PASS scene.yaml: 100.000% of pixels within 2/65535 (max 1.0 codes)".
+std::string verdict_line(const std::string& scene_path, const CheckResult& result, const CheckOptions& options);
 
 }  // namespace whitted::reference

@@ -22,6 +22,10 @@ struct ImageComparison {
     float worst_ours[3] = {0, 0, 0}, worst_theirs[3] = {0, 0, 0};
 };
 
+/// The share of pixels within tolerance as a percentage with three decimals, rounded down so
+/// that a failing share never reads "100.000%".
+std::string format_percent(const ImageComparison& comparison);
+
 ImageComparison compare_images(const Image& ours, const Image& theirs, double tolerance);
 
 /// Reads any image OpenImageIO can read as linear float RGB (no colour conversion: PNGs that

@@ -1,1 +1,332 @@
+// SPDX-License-Identifier: MIT
+// The report of `whitted check --report DIR`: the two images, a difference heat map, the
+// figures as JSON and one HTML page that shows them side by side. The page needs nothing but
+// the files next to it (no scripts, no web fonts), so a CI artefact can be opened anywhere.
 
+#include "reference/check.h"
+
+#include "whitted/output/image_output.h"
+
+#include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <stdexcept>
+
+namespace whitted::reference {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string html_escape(const std::string& text) {
+    std::string out;
+    for (const char c : text) {
+        switch (c) {
+            case '&':
+                out += "&amp;";
+                break;
+            case '<':
+                out += "&lt;";
+                break;
+            case '>':
+                out += "&gt;";
+                break;
+            case '"':
+                out += "&quot;";
+                break;
+            case '\'':
+                out += "&#39;";
+                break;
+            default:
+                out += c;
+        }
+    }
+    return out;
+}
+
+/// Quotes a word for a POSIX shell, so the reproduce commands can be pasted as they are.
+std::string shell_quote(const std::string& word) {
+    if (!word.empty() &&
+        word.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-./+=:,@") ==
+            std::string::npos)
+        return word;
+    std::string out = "'";
+    for (const char c : word) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return out + "'";
+}
+
+/// Heat-map colour of one pixel's largest channel difference. Full scale is twice the
+/// tolerance, so the tolerance sits at mid-scale: within it black → blue, beyond it a jump to
+/// yellow → red (saturating at 2× the tolerance). A failing pixel can never look like a passing one.
+void heat_colour(double difference, double tolerance, unsigned char* rgb) {
+    const double t = tolerance > 0 ? tolerance : 1.0 / 65535.0;
+    double r, g, b;
+    if (!(difference > t) && !std::isnan(difference)) {
+        const double u = difference / t;
+        r = 0.25 * u, g = 0.55 * u, b = 1.0 * u;
+    } else {
+        const double u = std::isnan(difference) ? 1.0 : std::min((difference - t) / t, 1.0);
+        r = 1.0, g = 0.85 * (1 - u), b = 0.0;
+    }
+    rgb[0] = static_cast<unsigned char>(std::lround(r * 255));
+    rgb[1] = static_cast<unsigned char>(std::lround(g * 255));
+    rgb[2] = static_cast<unsigned char>(std::lround(b * 255));
+}
+
+/// Writes display-ready 8-bit pixels unchanged: the heat map's colours are already what should
+/// be seen, so no display transform may touch them.
+void write_raw_png(const std::vector<unsigned char>& pixels, int width, int height, const fs::path& path) {
+    auto out = OIIO::ImageOutput::create(path.string());
+    if (!out) throw std::runtime_error("cannot write '" + path.string() + "': " + OIIO::geterror());
+    OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+    spec.attribute("Software", "Whitted (whitted check)");
+    if (!out->open(path.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, pixels.data()) || !out->close())
+        throw std::runtime_error("cannot write '" + path.string() + "': " + out->geterror());
+}
+
+Image absolute_difference(const Image& a, const Image& b) {
+    Image d = a;
+    for (size_t i = 0; i < d.rgb.size(); ++i) d.rgb[i] = std::abs(a.rgb[i] - b.rgb[i]);
+    return d;
+}
+
+Image divided(const Image& image, double exposure) {
+    Image out = image;
+    for (float& v : out.rgb) v = float(double(v) / exposure);  // a power of two: exact
+    return out;
+}
+
+nlohmann::json rgb_json(const float* v) {
+    return nlohmann::json::array({double(v[0]), double(v[1]), double(v[2])});
+}
+
+nlohmann::json metrics_json(const std::string& scene_path, const CheckResult& r, const CheckOptions& options) {
+    const ImageComparison& c = r.comparison;
+    nlohmann::json j;
+    j["scene"] = fs::absolute(scene_path).string();
+    j["passed"] = r.passed;
+    j["width"] = c.width;
+    j["height"] = c.height;
+    j["samples"] = r.samples;
+    j["exposure"] = r.exposure;
+    j["tolerance"] = options.tolerance;
+    j["tolerance_codes"] = options.tolerance * 65535;
+    j["required_fraction"] = options.required_fraction;
+    j["max_error"] = c.max_error;
+    j["max_error_codes"] = c.max_error * 65535;
+    j["mean_error"] = c.mean_error;
+    j["rms_error"] = c.rms_error;
+    // JSON has no infinity: identical images give null and "identical": true.
+    j["psnr_db"] = std::isinf(c.psnr) ? nlohmann::json(nullptr) : nlohmann::json(c.psnr);
+    j["identical"] = c.max_error == 0;
+    j["pixels"] = c.pixels;
+    j["pixels_within"] = c.pixels_within;
+    j["fraction_within"] = c.fraction_within();
+    j["worst_pixel"] = {
+        {"x", c.worst_x}, {"y", c.worst_y}, {"whitted", rgb_json(c.worst_ours)}, {"povray", rgb_json(c.worst_theirs)}};
+    j["whitted_seconds"] = r.whitted_seconds;
+    j["povray_seconds"] = r.povray_seconds;
+    j["povray_runs"] = r.povray_runs;
+    j["povray_program"] = r.povray_program;
+    j["files"] = {{"pov", r.pov_file},         {"ini", r.ini_file},          {"povray_output", r.povray_image},
+                  {"whitted_exr", "ours.exr"}, {"povray_exr", "povray.exr"}, {"difference_exr", "diff.exr"},
+                  {"whitted_png", "ours.png"}, {"povray_png", "povray.png"}, {"heat_map_png", "diff.png"}};
+    return j;
+}
+
+std::string codes_text(double value) {
+    return fmt::format("{:.1f}", value * 65535.0);
+}
+
+std::string rgb_cells(const float* v) {
+    return fmt::format("<td>{:.6f}</td><td>{:.6f}</td><td>{:.6f}</td>", v[0], v[1], v[2]);
+}
+
+std::string code_cells(const float* v) {
+    return fmt::format("<td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td>", double(v[0]) * 65535.0, double(v[1]) * 65535.0,
+                       double(v[2]) * 65535.0);
+}
+
+/// One image of the side-by-side row, drawn with visible pixels and a box on the worst pixel.
+std::string figure(const std::string& file, const std::string& caption, const ImageComparison& c, int scale) {
+    return fmt::format(
+        "<figure><div class=\"frame\" style=\"width:{w}px;height:{h}px\">"
+        "<a href=\"{f}\"><img src=\"{f}\" width=\"{w}\" height=\"{h}\" alt=\"{cap}\"></a>"
+        "<div class=\"worst\" style=\"left:{x}px;top:{y}px;width:{s}px;height:{s}px\" title=\"worst pixel\"></div>"
+        "</div><figcaption>{cap}</figcaption></figure>\n",
+        fmt::arg("w", c.width * scale), fmt::arg("h", c.height * scale), fmt::arg("f", file), fmt::arg("cap", caption),
+        fmt::arg("x", c.worst_x * scale - 2), fmt::arg("y", c.worst_y * scale - 2), fmt::arg("s", scale));
+}
+
+std::string report_html(const std::string& dir, const std::string& scene_path, const CheckResult& r,
+                        const CheckOptions& options) {
+    const ImageComparison& c = r.comparison;
+    const std::string verdict = verdict_line(scene_path, r, options);
+    const double tolerance_codes = options.tolerance * 65535;
+    // Small test images are enlarged by a whole factor so single pixels can be seen.
+    const int scale = std::clamp(320 / std::max({c.width, c.height, 1}), 1, 16);
+    const std::string scene_abs = fs::absolute(scene_path).string();
+    const std::string dir_abs = fs::absolute(dir).string();
+    const std::string exposure_note =
+        r.exposure == 1 ? std::string("1 (all values of the scene are at most 1)")
+                        : fmt::format(
+                              "{:g} = 2<sup>{:g}</sup>: the scene has values above 1, so POV-Ray rendered it "
+                              "with every light, the ambient light and the background multiplied by this, and "
+                              "Whitted's image was multiplied by the same (exact: a power of two)",
+                              r.exposure, std::log2(r.exposure));
+
+    std::string h;
+    h += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
+    h += "<title>" + html_escape((r.passed ? "PASS " : "FAIL ") + fs::path(scene_path).filename().string()) +
+         " - whitted check</title>\n";
+    h += R"(<style>
+body { font: 14px/1.45 system-ui, sans-serif; margin: 1.5em; color: #222; max-width: 1400px; }
+h1 { font-size: 1.3em; } h2 { font-size: 1.1em; margin-top: 1.6em; }
+.verdict { display: inline-block; padding: .2em .6em; border-radius: 4px; color: #fff; font-weight: bold; }
+.pass { background: #1a7f37; } .fail { background: #cf222e; }
+.row { display: flex; flex-wrap: wrap; gap: 1.2em; align-items: flex-start; }
+figure { margin: 0; }
+figcaption { font-size: .9em; color: #444; margin-top: .3em; max-width: 420px; }
+.frame { position: relative; background: #888; }
+.frame img { display: block; image-rendering: pixelated; image-rendering: crisp-edges; }
+.worst { position: absolute; border: 2px solid #ff00ff; box-sizing: content-box; pointer-events: none; }
+table { border-collapse: collapse; margin-top: .4em; }
+td, th { border: 1px solid #ccc; padding: .2em .6em; text-align: right; font-variant-numeric: tabular-nums; }
+th { background: #f3f3f3; text-align: left; }
+.legend { width: 320px; height: 14px; border: 1px solid #999;
+          background: linear-gradient(to right, #000 0%, #408cff 50%, #ffd900 50%, #ff0000 100%); }
+.legend-labels { display: flex; justify-content: space-between; width: 322px; font-size: .8em; }
+pre { background: #f6f8fa; padding: .6em; overflow-x: auto; }
+code { font-size: .95em; }
+</style>
+</head>
+<body>
+)";
+    h += "<h1>whitted check: " + html_escape(scene_path) + "</h1>\n";
+    h += "<p><span class=\"verdict " + std::string(r.passed ? "pass" : "fail") + "\">" + (r.passed ? "PASS" : "FAIL") +
+         "</span> <code>" + html_escape(verdict) + "</code></p>\n";
+
+    h += "<h2>Images</h2>\n<div class=\"row\">\n";
+    h += figure("ours.png", "Whitted (display sRGB of the linear image)", c, scale);
+    h += figure("povray.png", "POV-Ray 3.7 (same display transform)", c, scale);
+    h += figure("diff.png",
+                fmt::format("Difference: largest |Whitted − POV-Ray| over R, G, B; full scale = 2 × tolerance "
+                            "= {:g} codes",
+                            2 * tolerance_codes),
+                c, scale);
+    h += "</div>\n";
+    h += fmt::format(
+        "<p>Heat map scale (per pixel, the largest channel difference in 16-bit codes of 1/65535):</p>\n"
+        "<div class=\"legend\"></div>\n<div class=\"legend-labels\"><span>0</span><span>{0:g} = tolerance</span>"
+        "<span>≥ {1:g}</span></div>\n"
+        "<p>Black to blue: within the tolerance (blue = exactly at it). Yellow to red: outside it (red = twice the "
+        "tolerance or more). The magenta box marks the worst pixel. Images shown {2}× enlarged"
+        "{3}; click one for the file.</p>\n",
+        tolerance_codes, 2 * tolerance_codes, scale,
+        r.exposure != 1 ? fmt::format(", at exposure {:g}", r.exposure) : std::string());
+
+    h += "<h2>Figures</h2>\n<table>\n";
+    auto row = [&](const std::string& name, const std::string& value) {
+        h += "<tr><th>" + name + "</th><td>" + value + "</td></tr>\n";
+    };
+    row("max error", fmt::format("{:.3e} ({} codes)", c.max_error, codes_text(c.max_error)));
+    row("mean error", fmt::format("{:.3e} ({:.3f} codes)", c.mean_error, c.mean_error * 65535));
+    row("RMS error", fmt::format("{:.3e} ({:.3f} codes)", c.rms_error, c.rms_error * 65535));
+    row("PSNR (peak 1)", std::isinf(c.psnr) ? std::string("∞ (identical)") : fmt::format("{:.1f} dB", c.psnr));
+    row(fmt::format("pixels within {:g}/65535", tolerance_codes),
+        fmt::format("{} ({} of {}; {:g}% required)", format_percent(c), c.pixels_within, c.pixels,
+                    100 * options.required_fraction));
+    row("image",
+        fmt::format("{}×{}, image.samples = {}{}", c.width, c.height, r.samples,
+                    r.samples > 1 ? fmt::format(" (POV-Ray rendered {}×{} and each {}×{} block was averaged)",
+                                                c.width * r.samples, c.height * r.samples, r.samples, r.samples)
+                                  : std::string()));
+    row("exposure", exposure_note);
+    row("render time", fmt::format("Whitted {:.3f} s; POV-Ray {:.2f} s ({} run{})", r.whitted_seconds, r.povray_seconds,
+                                   r.povray_runs, r.povray_runs == 1 ? "" : "s"));
+    row("POV-Ray", "<code>" + html_escape(r.povray_program) + "</code>");
+    h += "</table>\n";
+
+    h += fmt::format("<h2>Worst pixel ({}, {})</h2>\n", c.worst_x, c.worst_y);
+    h += "<p>Column from the left, row from the top; values are linear, at the compared exposure.</p>\n";
+    h += "<table>\n<tr><th></th><th>R</th><th>G</th><th>B</th><th>R codes</th><th>G codes</th><th>B codes</th></tr>\n";
+    h += "<tr><th>Whitted</th>" + rgb_cells(c.worst_ours) + code_cells(c.worst_ours) + "</tr>\n";
+    h += "<tr><th>POV-Ray</th>" + rgb_cells(c.worst_theirs) + code_cells(c.worst_theirs) + "</tr>\n";
+    float difference[3];
+    for (int ch = 0; ch < 3; ++ch) difference[ch] = c.worst_ours[ch] - c.worst_theirs[ch];
+    h += fmt::format("<tr><th>Whitted − POV-Ray</th><td>{:+.2e}</td><td>{:+.2e}</td><td>{:+.2e}</td>", difference[0],
+                     difference[1], difference[2]) +
+         code_cells(difference) + "</tr>\n</table>\n";
+
+    h += "<h2>Files</h2>\n<ul>\n";
+    const std::pair<const char*, const char*> files[] = {
+        {"ours.exr",
+         "Whitted, linear float, at the scene's own scale (what <code>whitted render -o x.exr</code> writes)"},
+        {"povray.exr", "POV-Ray, linear float, divided by the exposure back to the scene's scale"},
+        {"diff.exr", "|Whitted − POV-Ray| per channel, linear, at the compared exposure"},
+        {"povray-16bit.png", "POV-Ray's own output: linear 16-bit PNG (gAMA 1.0)"},
+        {"scene.pov", "the converted scene"},
+        {"scene.ini", "POV-Ray's options (size, no antialiasing, 16-bit linear PNG)"},
+        {"povray.log", "what POV-Ray printed"},
+        {"metrics.json", "the figures above, machine-readable"}};
+    for (const auto& [file, what] : files)
+        h += fmt::format("<li><a href=\"{0}\"><code>{0}</code></a>: {1}</li>\n", file, what);
+    h += "</ul>\n";
+
+    h += "<h2>Reproduce</h2>\n<pre>";
+    h += html_escape("whitted render " + shell_quote(scene_abs) + " -o ours.exr\n");
+    h += html_escape("cd " + shell_quote(dir_abs) + " && HOME=$(mktemp -d) povray " + r.ini_file + "\n");
+    h += html_escape("whitted check " + shell_quote(scene_abs) + " --report " + shell_quote(dir_abs) +
+                     fmt::format(" --tolerance {:g}", tolerance_codes) + "\n");
+    h += "</pre>\n<p>See <code>docs/validation.md</code> for the mapping, the conventions and the tolerance.</p>\n";
+    h += "</body>\n</html>\n";
+    return h;
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+    out.close();
+    if (!out) throw std::runtime_error("cannot write '" + path.string() + "'");
+}
+
+}  // namespace
+
+void write_report(const std::string& dir, const std::string& scene_path, const Image& ours, const Image& theirs,
+                  const CheckResult& result, const CheckOptions& options) {
+    const fs::path d(dir);
+    std::error_code error;
+    fs::create_directories(d, error);
+    if (!fs::is_directory(d)) throw std::runtime_error("cannot create the report directory '" + dir + "'");
+
+    const Image difference = absolute_difference(ours, theirs);
+    OutputOptions linear;
+    linear.metadata = {{"whitted:scene", fs::absolute(scene_path).string()}};
+    write_image(divided(ours, result.exposure), (d / "ours.exr").string(), linear);
+    write_image(divided(theirs, result.exposure), (d / "povray.exr").string(), linear);
+    write_image(difference, (d / "diff.exr").string(), linear);
+    // The default display transform (sRGB), the same for both so they look alike exactly when
+    // they are alike.
+    write_image(ours, (d / "ours.png").string(), {});
+    write_image(theirs, (d / "povray.png").string(), {});
+
+    std::vector<unsigned char> heat(size_t(difference.width) * size_t(difference.height) * 3);
+    for (size_t i = 0; i < heat.size() / 3; ++i) {
+        const float* p = &difference.rgb[3 * i];
+        const double worst = std::isnan(p[0]) || std::isnan(p[1]) || std::isnan(p[2])
+                                 ? std::numeric_limits<double>::quiet_NaN()
+                                 : double(std::max({p[0], p[1], p[2]}));
+        heat_colour(worst, options.tolerance, &heat[3 * i]);
+    }
+    write_raw_png(heat, difference.width, difference.height, d / "diff.png");
+
+    write_text(d / "metrics.json", metrics_json(scene_path, result, options).dump(2) + "\n");
+    write_text(d / "report.html", report_html(dir, scene_path, result, options));
+}
+
+}  // namespace whitted::reference
