@@ -5,6 +5,7 @@
 
 #include <tiny_obj_loader.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <unordered_map>
 
@@ -90,8 +91,10 @@ MeshData load_obj_mesh(const std::string& path, const SourceLocation& referenced
     if (direct) {
         mesh.positions.assign(attrib.vertices.begin(), attrib.vertices.end());
         if (smooth) {
-            mesh.normals.assign(attrib.normals.begin(), attrib.normals.begin() + 3 * position_count);
-            if (normal_count < position_count) mesh.normals.resize(3 * position_count, 0.0f);
+            // A file may have fewer vn than v lines (vertices no face uses): copy what there is.
+            const size_t copied = std::min(normal_count, position_count);
+            mesh.normals.assign(attrib.normals.begin(), attrib.normals.begin() + 3 * copied);
+            mesh.normals.resize(3 * position_count, 0.0f);
         }
     }
     // Otherwise: one vertex per distinct (position, normal) pair, so normals index like positions.
