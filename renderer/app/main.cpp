@@ -32,8 +32,16 @@ constexpr int exit_ok = 0, exit_failure = 1, exit_bad_input = 2;
 
 std::atomic<bool> g_cancel{false};
 std::atomic<int> g_signal{0};
+/// Until the render starts nothing is written and nothing checks g_cancel (parsing, loading
+/// meshes, building the BVH can take seconds), so a signal then ends the program at once.
+std::atomic<bool> g_exit_on_signal{true};
 
 extern "C" void on_signal(int signal) {
+    if (g_exit_on_signal.load()) {
+        static const char message[] = "whitted: interrupted; nothing written\n";
+        [[maybe_unused]] const auto ignored = ::write(STDERR_FILENO, message, sizeof message - 1);
+        ::_exit(128 + signal);  // async-signal-safe; no temporary file exists yet
+    }
     g_signal.store(signal);
     g_cancel.store(true);
 }
@@ -72,6 +80,7 @@ struct RenderArguments {
     std::string scene, output = "whitted.png";
     int threads = 0;
     bool quiet = false, half = false, partial = false, stats = false;
+    std::string exr_compression = "none";
     int bit_depth = 0;
     std::string ocio_config, display, view;
 };
@@ -95,6 +104,7 @@ int run_render(const RenderArguments& args) {
     StageTimer timer;
     Scene scene;
     double parse_seconds = 0, validate_seconds = 0;
+    install_signal_handlers();
     try {
         check_output_path(args.output);
         const SceneDescription description = parse_scene_file(args.scene);
@@ -107,22 +117,30 @@ int run_render(const RenderArguments& args) {
     } catch (const std::invalid_argument& e) {
         print_error(e.what());
         return exit_bad_input;
+    } catch (const std::bad_alloc&) {
+        // A scene or mesh too large for this machine's memory: an error, never an abort.
+        print_error(args.scene + ": out of memory while reading the scene");
+        return exit_failure;
+    } catch (const std::exception& e) {  // e.g. a filesystem error while reading
+        print_error(args.scene + ": " + e.what());
+        return exit_bad_input;
     }
 
     try {
-        install_signal_handlers();
         const Accelerator accelerator(scene);
         const double build_seconds = timer.lap();
         RenderOptions options;
         options.threads = args.threads;
         options.cancel = &g_cancel;
         if (!args.quiet && ::isatty(STDERR_FILENO)) options.on_progress = draw_progress;
+        g_exit_on_signal.store(false);  // from here on a signal cancels, and we clean up
         RenderResult result = render(scene, accelerator, options);
         if (options.on_progress) std::fputc('\n', stderr);
         timer.lap();
 
         OutputOptions output;
         output.half = args.half;
+        output.exr_compression = args.exr_compression;
         output.bit_depth = args.bit_depth;
         output.ocio_config = args.ocio_config;
         output.display = args.display;
@@ -237,6 +255,11 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(0, 4096));
     render_cmd->add_flag("-q,--quiet", render_args.quiet, "No progress bar and no summary line");
     render_cmd->add_flag("--half", render_args.half, "EXR: write half floats instead of 32-bit floats");
+    render_cmd
+        ->add_option("--exr-compression", render_args.exr_compression,
+                     "EXR compression, all lossless: none (fastest to write), zip, zips, piz, rle")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"none", "zip", "zips", "piz", "rle"}));
     render_cmd->add_option("--bit-depth", render_args.bit_depth, "PNG/TIFF bits per channel (8 or 16)")
         ->check(CLI::IsMember({8, 16}));
     render_cmd->add_option("--ocio-config", render_args.ocio_config,

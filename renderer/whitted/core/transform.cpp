@@ -50,6 +50,7 @@ Transform Transform::from_rows(const Rows& m) {
     Transform t;
     t.m_forward = m;
     t.m_inverse = invert(m);
+    t.m_identity = m == Rows{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
     return t;
 }
 
@@ -75,6 +76,7 @@ Transform Transform::then(const Transform& b) const {
     Transform r;
     r.m_forward = multiply(b.m_forward, m_forward);
     r.m_inverse = multiply(m_inverse, b.m_inverse);
+    r.m_identity = r.m_forward == Rows{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
     return r;
 }
 
@@ -106,10 +108,6 @@ Vec3 Transform::inverse_vector(const Vec3& v) const {
     const Rows& m = m_inverse;
     return {m[0] * v.x + m[1] * v.y + m[2] * v.z, m[4] * v.x + m[5] * v.y + m[6] * v.z,
             m[8] * v.x + m[9] * v.y + m[10] * v.z};
-}
-
-bool Transform::is_identity() const {
-    return m_forward == Rows{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
 }
 
 double Transform::determinant() const {

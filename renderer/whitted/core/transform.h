@@ -29,7 +29,8 @@ public:
     Vec3 inverse_point(const Vec3& p) const;
     Vec3 inverse_vector(const Vec3& v) const;
 
-    bool is_identity() const;
+    /// Cached: shapes ask on every intersection test.
+    bool is_identity() const { return m_identity; }
     double determinant() const;
     const std::array<double, 12>& rows() const { return m_forward; }
 
@@ -37,6 +38,7 @@ private:
     // Row-major top three rows of the forward and inverse matrices.
     std::array<double, 12> m_forward{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
     std::array<double, 12> m_inverse{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    bool m_identity = true;
 };
 
 /// Determinant of the linear 3x3 part of a row-major 3x4 matrix.

@@ -88,13 +88,26 @@ using WriteDisplayImage = std::string (*)(const std::string& format_path, const 
 
 namespace {
 
-void write_exr(const Image& image, const std::string& temp_path, bool half,
+Imf::Compression exr_compression(const std::string& name) {
+    if (name.empty() || name == "none") return Imf::NO_COMPRESSION;
+    if (name == "zip") return Imf::ZIP_COMPRESSION;
+    if (name == "zips") return Imf::ZIPS_COMPRESSION;
+    if (name == "piz") return Imf::PIZ_COMPRESSION;
+    if (name == "rle") return Imf::RLE_COMPRESSION;
+    throw std::invalid_argument("unknown EXR compression '" + name + "'; use none, zip, zips, piz or rle");
+}
+
+void write_exr(const Image& image, const std::string& temp_path, bool half, Imf::Compression compression,
                const std::vector<std::pair<std::string, std::string>>& metadata) {
     // OpenEXR directly (not through OpenImageIO) keeps EXR renders free of OpenImageIO's
     // start-up cost; ZIP blocks are compressed on all cores.
     Imf::setGlobalThreadCount(int(std::thread::hardware_concurrency()));
     Imf::Header header(image.width, image.height);
-    header.compression() = Imf::ZIP_COMPRESSION;
+    // Uncompressed by default: deflate (zip) on a 1280x960 float image took 0.3-0.4 s, as long as
+    // rendering it, to save about a third of the bytes (docs/performance.md). --exr-compression
+    // picks another lossless scheme.
+    header.compression() = compression;
+    header.zipCompressionLevel() = 1;
     const Imf::PixelType type = half ? Imf::HALF : Imf::FLOAT;
     for (const char* channel : {"R", "G", "B"}) header.channels().insert(channel, Imf::Channel(type));
     for (const auto& [key, value] : metadata) header.insert(key, Imf::StringAttribute(value));
@@ -131,7 +144,7 @@ void write_image(const Image& image, const std::string& path, const OutputOption
     TemporaryFile temporary(path);
     if (kind == OutputKind::linear_exr) {
         metadata.push_back({"whitted:colorspace", "Linear Rec.709 (sRGB), scene-referred"});
-        write_exr(image, temporary.path(), options.half, metadata);
+        write_exr(image, temporary.path(), options.half, exr_compression(options.exr_compression), metadata);
     } else {
         std::vector<float> pixels = image.rgb;
         const DisplayTransform display(options.ocio_config, options.display, options.view);
