@@ -21,13 +21,21 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <stdexcept>
 
 namespace whitted::pov {
 namespace {
 
 /// The shortest decimal that reads back as the same double (fmt uses Dragonbox): POV-Ray
 /// parses it to exactly the value Whitted uses.
+/// Thrown by num(): POV-Ray has no spelling for infinity or NaN, and a finite scene can
+/// still overflow once divided or transformed here (ka/kd, 1/p, a product of matrices).
+struct NotFinite : std::overflow_error {
+    using std::overflow_error::overflow_error;
+};
+
 std::string num(double v) {
+    if (!std::isfinite(v)) throw NotFinite(fmt::format("{}", v));
     if (v == 0) return "0";  // also turns −0 into 0
     return fmt::format("{}", v);
 }
@@ -249,7 +257,19 @@ double radiance_upper_bound(const SceneDescription& d) {
     return bound;
 }
 
+static std::string write_sdl(const SceneDescription& d, const ConvertOptions& options);
+
 std::string scene_to_sdl(const SceneDescription& d, const ConvertOptions& options) {
+    try {
+        return write_sdl(d, options);
+    } catch (const NotFinite& e) {
+        throw InputError({d.path}, std::string("cannot convert to POV-Ray: a value becomes ") + e.what() +
+                                       " once divided or transformed (ka/kd, 1/p, nested transforms); "
+                                       "POV-Ray cannot read it");
+    }
+}
+
+static std::string write_sdl(const SceneDescription& d, const ConvertOptions& options) {
     const double exposure = options.exposure;
     const double aspect = double(d.image.width.value) / double(d.image.height.value);
     std::string o;
