@@ -8,6 +8,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <utility>
@@ -40,6 +41,35 @@ __attribute__((visibility("default"))) int whitted_run_check(const std::string& 
     } catch (const whitted::InputError& e) {
         std::fprintf(stderr, "whitted: error: %s\n", e.what());
         return 2;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "whitted: error: %s\n", e.what());
+        return 2;
+    }
+}
+
+/// `whitted compare A B`: per-channel comparison of two images of the same size; with `clip`
+/// both are first clipped to [0, 1] (to compare a float EXR with a PNG, which clips).
+/// Returns 0 when at least `required_fraction` of the pixels are within `tolerance`, else 1; 2
+/// when an image cannot be read or the sizes differ.
+__attribute__((visibility("default"))) int whitted_run_compare(const std::string& first, const std::string& second,
+                                                               double tolerance, bool clip, double required_fraction) {
+    using namespace whitted::reference;
+    try {
+        whitted::Image a = read_linear_image(first), b = read_linear_image(second);
+        if (a.width != b.width || a.height != b.height) {
+            std::fprintf(stderr, "whitted: error: %s is %dx%d but %s is %dx%d\n", first.c_str(), a.width, a.height,
+                         second.c_str(), b.width, b.height);
+            return 2;
+        }
+        if (clip)
+            for (auto* image : {&a, &b})
+                for (float& v : image->rgb) v = std::min(std::max(v, 0.0f), 1.0f);
+        const ImageComparison c = compare_images(a, b, tolerance);
+        const bool passed = c.fraction_within() >= required_fraction;
+        std::printf("%s %s vs %s: %s of pixels within %.3g/65535, max %.2f codes at (%d, %d), RMS %.3g\n",
+                    passed ? "PASS" : "FAIL", first.c_str(), second.c_str(), format_percent(c).c_str(),
+                    tolerance * 65535, c.max_error * 65535, c.worst_x, c.worst_y, c.rms_error);
+        return passed ? 0 : 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "whitted: error: %s\n", e.what());
         return 2;

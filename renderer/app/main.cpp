@@ -228,6 +228,18 @@ int run_check_command(const std::string& scene_path, const reference::CheckOptio
     }
 }
 
+int run_compare_command(const std::string& first, const std::string& second, double tolerance, bool clip,
+                        double required_fraction) {
+    using RunCompare = int (*)(const std::string&, const std::string&, double, bool, double);
+    try {
+        const auto run_compare = reinterpret_cast<RunCompare>(image_io_plugin_symbol("whitted_run_compare"));
+        return run_compare(first, second, tolerance, clip, required_fraction);
+    } catch (const std::exception& e) {
+        print_error(e.what());
+        return exit_bad_input;
+    }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -297,6 +309,21 @@ int main(int argc, char** argv) {
     check_cmd->add_option("-t,--threads", check_options.threads, "Worker threads for Whitted (default: all cores)");
     check_cmd->add_flag("-q,--quiet", check_options.quiet, "Print only the verdict line");
 
+    std::string compare_first, compare_second;
+    double compare_tolerance = 2.0, compare_fraction = 0.999;
+    bool compare_clip = false;
+    CLI::App* compare_cmd =
+        app.add_subcommand("compare", "Compare two images pixel by pixel (e.g. a Whitted EXR and a POV-Ray PNG)");
+    compare_cmd->add_option("first", compare_first, "Image")->required()->check(CLI::ExistingFile);
+    compare_cmd->add_option("second", compare_second, "Image of the same size")->required()->check(CLI::ExistingFile);
+    compare_cmd->add_option("--tolerance", compare_tolerance, "Per-channel tolerance in 16-bit codes (1/65535)")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
+    compare_cmd->add_option("--min-fraction", compare_fraction, "Share of pixels that must be within tolerance")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1.0));
+    compare_cmd->add_flag("--clip", compare_clip, "Clip both images to [0, 1] first (PNG files clip at 1)");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -306,6 +333,9 @@ int main(int argc, char** argv) {
 
     if (*render_cmd) return run_render(render_args);
     if (*convert_cmd) return run_convert(convert_scene, convert_output);
+    if (*compare_cmd)
+        return run_compare_command(compare_first, compare_second, compare_tolerance / 65535.0, compare_clip,
+                                   compare_fraction);
     check_options.tolerance = tolerance_codes / 65535.0;
     return run_check_command(check_scene, check_options);
 }
