@@ -1,0 +1,85 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""Times Whitted against POV-Ray 3.7 on the anchor scenes (bench/generate.py), interleaved,
+whole process, median of N runs; checks that the two images agree; prints a table.
+Usage: bench/run.py WHITTED_BINARY OUT_DIR [--runs N] [--threads T] [--scenes a,b]"""
+import argparse
+import os
+import re
+import resource
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+
+def timed(cmd, cwd=None, env=None):
+    """Runs cmd, returns (wall seconds, peak RSS of the child in MB, stderr)."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    start = time.perf_counter()
+    proc = subprocess.run(cmd, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    wall = time.perf_counter() - start
+    if proc.returncode != 0:
+        sys.exit(f"bench: {' '.join(map(str, cmd))} failed ({proc.returncode}):\n{proc.stderr[-2000:]}")
+    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    return wall, max(peak, before) / 1024.0, proc.stderr
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("whitted")
+    ap.add_argument("out")
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--threads", type=int, default=os.cpu_count())
+    ap.add_argument("--scenes", default="spheres,torus100k,torus1m")
+    args = ap.parse_args()
+    out = Path(args.out).resolve()
+    here = Path(__file__).resolve().parent
+    subprocess.run([sys.executable, str(here / "generate.py"), str(out)], check=True, stdout=subprocess.DEVNULL)
+    povray = shutil.which("povray")
+    if not povray:
+        sys.exit("bench: POV-Ray 3.7 is needed: apt-get install povray")
+    home = tempfile.mkdtemp(prefix="whitted-bench-home-")
+    env = dict(os.environ, HOME=home)
+    env.pop("POVINI", None)
+
+    rows = []
+    for name in args.scenes.split(","):
+        scene = out / f"{name}.yaml"
+        pov = out / f"{name}.pov"
+        subprocess.run([args.whitted, "convert", str(scene), str(pov)], check=True, stderr=subprocess.DEVNULL)
+        ours_img, theirs_img = out / f"{name}.whitted.exr", out / f"{name}.povray.png"
+        pov_cmd = [povray, f"+I{pov.name}", f"+O{theirs_img.name}", "+W1280", "+H960", "-D", "-A", "+Q9", "+FN16",
+                   "File_Gamma=1.0", f"+WT{args.threads}", "-GA"]
+        our_cmd = [args.whitted, "render", str(scene), "-o", str(ours_img), "--threads", str(args.threads)]
+        pov_times, our_times, our_peak, rays = [], [], 0.0, 0.0
+        for _ in range(args.runs):  # interleaved, so both see the same machine state
+            wall, _, _ = timed(pov_cmd, cwd=out, env=env)
+            pov_times.append(wall)
+            wall, peak, err = timed(our_cmd)
+            our_times.append(wall)
+            our_peak = max(our_peak, peak)
+            m = re.search(r"([0-9.]+) M rays \(", err)
+            r = re.search(r"render ([0-9.]+)s", err)
+            if m and r:
+                rays = float(m.group(1)) / float(r.group(1))
+        agree = subprocess.run([args.whitted, "compare", str(ours_img), str(theirs_img), "--clip"],
+                               stdout=subprocess.PIPE, text=True)
+        pov_s, our_s = statistics.median(pov_times), statistics.median(our_times)
+        rows.append((name, pov_s, our_s, pov_s / our_s, rays, our_peak, agree.stdout.strip().split(":")[-1].strip(),
+                     agree.returncode))
+    shutil.rmtree(home, ignore_errors=True)
+
+    print(f"\n{args.threads} thread(s), median of {args.runs} interleaved runs, whole process wall time")
+    print(f"{'scene':<11} {'POV-Ray s':>9} {'Whitted s':>9} {'speed-up':>8} {'M rays/s':>8} {'peak MB':>8}  images")
+    for name, pov_s, our_s, speedup, rays, peak, agree, rc in rows:
+        print(f"{name:<11} {pov_s:9.3f} {our_s:9.3f} {speedup:7.1f}x {rays:8.1f} {peak:8.0f}  "
+              f"{'agree' if rc == 0 else 'DIFFER'}: {agree}")
+    return 0 if all(r[-1] == 0 for r in rows) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
