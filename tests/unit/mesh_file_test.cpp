@@ -1,0 +1,172 @@
+// SPDX-License-Identifier: MIT
+// Wavefront OBJ + MTL loading: the MTL's Ka/Kd/Ks/Ns become ka/kd/ks/p, `illum 3` (reflection)
+// makes km = Ks, polygons are split into triangles, and bad files are refused naming the file.
+
+#include "whitted/scene/mesh_file.h"
+#include "whitted/scene/scene.h"
+
+#include "test_support.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <set>
+
+namespace whitted {
+namespace {
+
+using ::testing::HasSubstr;
+
+const char* const two_materials_mtl =
+    "newmtl glass\n"
+    "Ka 0.1 0.2 0.3\n"
+    "Kd 0.4 0.5 0.6\n"
+    "Ks 0.7 0.8 0.9\n"
+    "Ns 25\n"
+    "illum 3\n"
+    "\n"
+    "newmtl tin\n"
+    "Ka 0 0 0\n"
+    "Kd 0.5 0.5 0.5\n"
+    "Ks 0.25 0.25 0.25\n"
+    "Ns 10\n"
+    "illum 2\n";
+
+// A unit square in z = 0 (one quad) and a triangle standing on its edge.
+const char* const quad_and_triangle_obj =
+    "mtllib materials.mtl\n"
+    "v 0 0 0\n"
+    "v 1 0 0\n"
+    "v 1 1 0\n"
+    "v 0 1 0\n"
+    "v 0 0 1\n"
+    "usemtl glass\n"
+    "f 1 2 3 4\n"
+    "usemtl tin\n"
+    "f 1 2 5\n";
+
+Vec3 position(const MeshData& mesh, uint32_t index) {
+    return {mesh.positions[3 * index], mesh.positions[3 * index + 1], mesh.positions[3 * index + 2]};
+}
+
+const MaterialDescription* find(const MeshData& mesh, const std::string& name) {
+    for (const auto& m : mesh.materials)
+        if (m.name == name) return &m;
+    return nullptr;
+}
+
+void expect_color_float(const Color& actual, float r, float g, float b) {
+    // The MTL reader keeps floats: compare with the float nearest each written decimal.
+    EXPECT_EQ(actual.x, double(r));
+    EXPECT_EQ(actual.y, double(g));
+    EXPECT_EQ(actual.z, double(b));
+}
+
+TEST(ObjMesh, MtlCoefficientsMapToTheLectureMaterial) {
+    const test::ScratchDirectory directory;
+    directory.write("materials.mtl", two_materials_mtl);
+    const MeshData mesh = load_obj_mesh(directory.write("model.obj", quad_and_triangle_obj), {});
+    ASSERT_EQ(mesh.materials.size(), 2u);
+    const MaterialDescription* glass = find(mesh, "glass");
+    const MaterialDescription* tin = find(mesh, "tin");
+    ASSERT_TRUE(glass && tin);
+    expect_color_float(glass->ka.value, 0.1f, 0.2f, 0.3f);
+    expect_color_float(glass->kd.value, 0.4f, 0.5f, 0.6f);
+    expect_color_float(glass->ks.value, 0.7f, 0.8f, 0.9f);
+    EXPECT_EQ(glass->p.value, 25.0);
+    expect_color_float(glass->km.value, 0.7f, 0.8f, 0.9f);  // illum 3: a mirror as strong as Ks
+    expect_color_float(tin->ks.value, 0.25f, 0.25f, 0.25f);
+    EXPECT_EQ(tin->p.value, 10.0);
+    EXPECT_EQ(tin->km.value, Color(0.0));  // illum 2: highlights, no mirror
+}
+
+// The quad becomes two triangles that tile the unit square (total area 1, both facing +z);
+// the triangle after it keeps its own material.
+TEST(ObjMesh, QuadIsSplitIntoTwoTriangles) {
+    const test::ScratchDirectory directory;
+    directory.write("materials.mtl", two_materials_mtl);
+    const MeshData mesh = load_obj_mesh(directory.write("model.obj", quad_and_triangle_obj), {});
+    ASSERT_EQ(mesh.indices.size(), 9u);
+    ASSERT_EQ(mesh.positions.size(), 15u);  // 5 vertices, no normals: used as written
+    EXPECT_TRUE(mesh.normals.empty());
+    double area = 0;
+    std::set<uint32_t> corners;
+    for (int t = 0; t < 2; ++t) {
+        const Vec3 a = position(mesh, mesh.indices[3 * t]), b = position(mesh, mesh.indices[3 * t + 1]),
+                   c = position(mesh, mesh.indices[3 * t + 2]);
+        const Vec3 n = cross(b - a, c - a);
+        EXPECT_GT(n.z, 0) << "triangle " << t << " keeps the quad's winding";
+        area += length(n) / 2;
+        for (int k = 0; k < 3; ++k) corners.insert(mesh.indices[3 * t + k]);
+    }
+    EXPECT_NEAR(area, 1.0, 1e-7);
+    EXPECT_EQ(corners, (std::set<uint32_t>{0, 1, 2, 3}));
+    EXPECT_EQ((std::vector<uint32_t>{mesh.indices[6], mesh.indices[7], mesh.indices[8]}),
+              (std::vector<uint32_t>{0, 1, 4}));
+    ASSERT_EQ(mesh.triangle_material.size(), 3u);
+    EXPECT_EQ(mesh.materials[size_t(mesh.triangle_material[0])].name, "glass");
+    EXPECT_EQ(mesh.materials[size_t(mesh.triangle_material[1])].name, "glass");
+    EXPECT_EQ(mesh.materials[size_t(mesh.triangle_material[2])].name, "tin");
+}
+
+// Normals indexed apart from positions: every (position, normal) pair becomes one vertex so that
+// normals index like positions.
+TEST(ObjMesh, VertexNormalsFollowTheirCorners) {
+    const test::ScratchDirectory directory;
+    const MeshData mesh = load_obj_mesh(directory.write("n.obj",
+                                                        "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                                                        "vn 0 0 1\nvn 0 1 0\n"
+                                                        "f 1//2 2//1 3//1\n"),
+                                        {});
+    ASSERT_EQ(mesh.indices.size(), 3u);
+    ASSERT_EQ(mesh.normals.size(), mesh.positions.size());
+    const auto normal = [&](uint32_t i) {
+        return Vec3{mesh.normals[3 * i], mesh.normals[3 * i + 1], mesh.normals[3 * i + 2]};
+    };
+    EXPECT_EQ(position(mesh, mesh.indices[0]), (Vec3{0, 0, 0}));
+    EXPECT_EQ(normal(mesh.indices[0]), (Vec3{0, 1, 0}));
+    EXPECT_EQ(position(mesh, mesh.indices[1]), (Vec3{1, 0, 0}));
+    EXPECT_EQ(normal(mesh.indices[1]), (Vec3{0, 0, 1}));
+    EXPECT_EQ(position(mesh, mesh.indices[2]), (Vec3{0, 1, 0}));
+    EXPECT_EQ(normal(mesh.indices[2]), (Vec3{0, 0, 1}));
+}
+
+TEST(ObjMesh, OutOfRangeFaceIndexNamesTheFile) {
+    const test::ScratchDirectory directory;
+    const std::string path = directory.write("broken.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+    const auto error = test::input_error_from([&] { (void)load_obj_mesh(path, {"scene.yaml", 4, 11}); });
+    ASSERT_TRUE(error);
+    EXPECT_THAT(std::string(error->what()), HasSubstr(path));
+}
+
+// In a scene: the path is relative to the scene file; without `material:` the MTL's materials
+// are used per face, with it every face takes the override.
+TEST(ObjMesh, SceneUsesMtlMaterialsUnlessOverridden) {
+    const test::ScratchDirectory directory;
+    std::filesystem::create_directories(directory.path() / "models");
+    directory.write("models/materials.mtl", two_materials_mtl);
+    directory.write("models/model.obj", quad_and_triangle_obj);
+    const std::string scene_path = (directory.path() / "scene.yaml").string();
+    const std::string head =
+        "camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\nimage: {width: 2, height: 2}\n"
+        "materials:\n  red: {kd: [1, 0, 0]}\nobjects:\n";
+
+    const Scene from_mtl = test::scene_from(head + "  - {type: mesh, file: models/model.obj}\n", scene_path);
+    ASSERT_EQ(from_mtl.meshes.size(), 1u);
+    ASSERT_EQ(from_mtl.meshes[0].triangle_materials.size(), 3u);
+    const Material& first = from_mtl.materials[from_mtl.meshes[0].triangle_materials[0]];
+    const Material& last = from_mtl.materials[from_mtl.meshes[0].triangle_materials[2]];
+    EXPECT_EQ(first.km, Color(double(0.7f), double(0.8f), double(0.9f)));
+    EXPECT_EQ(first.p, 25.0);
+    EXPECT_EQ(last.km, Color(0.0));
+    EXPECT_EQ(last.p, 10.0);
+
+    const Scene overridden =
+        test::scene_from(head + "  - {type: mesh, file: models/model.obj, material: red}\n", scene_path);
+    ASSERT_EQ(overridden.meshes.size(), 1u);
+    EXPECT_TRUE(overridden.meshes[0].triangle_materials.empty());
+    EXPECT_EQ(overridden.materials[overridden.meshes[0].material].kd, (Color{1, 0, 0}));
+}
+
+}  // namespace
+}  // namespace whitted

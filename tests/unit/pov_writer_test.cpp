@@ -1,0 +1,178 @@
+// SPDX-License-Identifier: MIT
+// The POV-Ray converter (pov-model.md §1): numbers are written so that POV-Ray reads back the
+// very doubles Whitted uses, nothing from the scene except numbers reaches the SDL, and the
+// lecture's material becomes recipe A (one texture, grey ks) or recipe B (four layered textures).
+
+#include "converters/pov_writer.h"
+#include "whitted/scene/description.h"
+
+#include "test_support.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+
+namespace whitted {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+/// The `count` numbers that follow `prefix` in `text` (separators: spaces, commas, '<', '>'),
+/// read with strtod exactly as a C library reads a decimal.
+std::vector<double> numbers_after(const std::string& text, const std::string& prefix, size_t count, size_t from = 0) {
+    const size_t at = text.find(prefix, from);
+    EXPECT_NE(at, std::string::npos) << "'" << prefix << "' not in the SDL";
+    if (at == std::string::npos) return std::vector<double>(count, std::nan(""));
+    const char* p = text.c_str() + at + prefix.size();
+    std::vector<double> out;
+    while (out.size() < count) {
+        while (*p == ' ' || *p == ',' || *p == '<' || *p == '>') ++p;
+        char* end = nullptr;
+        const double value = std::strtod(p, &end);
+        EXPECT_NE(end, p) << "no number at '" << std::string(p, std::min<size_t>(20, std::strlen(p))) << "'";
+        if (end == p) break;
+        out.push_back(value);
+        p = end;
+    }
+    return out;
+}
+
+size_t count_of(const std::string& text, const std::string& word) {
+    size_t n = 0;
+    for (size_t at = text.find(word); at != std::string::npos; at = text.find(word, at + 1)) ++n;
+    return n;
+}
+
+std::string sdl_for(const std::string& objects_and_materials, const std::string& path = "scene.yaml") {
+    const SceneDescription d =
+        parse_scene_text("camera: {eye: [0, 1, 5], look_at: [0, 0, 0], fov: 50}\nimage: {width: 40, height: 30}\n" +
+                             objects_and_materials,
+                         path);
+    (void)validate_scene(d);  // the converter's input is always a valid scene
+    return pov::scene_to_sdl(d);
+}
+
+// Awkward doubles (0.1 + 0.2, tiny, huge, many digits) come back bit for bit.
+TEST(PovWriter, NumbersRoundTripExactly) {
+    const std::string text =
+        "lights:\n  - {type: point, position: [0.30000000000000004, -1.0000000000000002e-7, 123456.78901234567]}\n"
+        "objects:\n"
+        "  - {type: sphere, center: [0.1, -2.718281828459045, 3.0e+21], radius: 0.7071067811865476,\n"
+        "     material: {kd: [0.123456789012345678, 0.1, 1e-300]}}\n";
+    const SceneDescription d = parse_scene_text(
+        "camera: {eye: [0, 1, 5], look_at: [0, 0, 0], fov: 33.3}\nimage: {width: 7, height: 3}\n" + text, "scene.yaml");
+    const std::string sdl = pov::scene_to_sdl(d);
+
+    const auto light = numbers_after(sdl, "light_source {", 3);
+    EXPECT_EQ(light, (std::vector<double>{0.30000000000000004, -1.0000000000000002e-7, 123456.78901234567}));
+    const auto sphere = numbers_after(sdl, "sphere {", 4);
+    EXPECT_EQ(sphere, (std::vector<double>{0.1, -2.718281828459045, 3.0e+21, 0.7071067811865476}));
+    EXPECT_EQ(sphere[3], d.objects[0].radius.value);
+    const auto pigment = numbers_after(sdl, "pigment { rgb", 3);
+    EXPECT_EQ(pigment, (std::vector<double>{0.123456789012345678, 0.1, 1e-300}));
+    EXPECT_EQ(numbers_after(sdl, "angle", 1)[0], 33.3);
+    // A right-handed scene is rendered by POV-Ray with `right −x·W/H`.
+    EXPECT_EQ(numbers_after(sdl, "right", 3), (std::vector<double>{-7.0 / 3.0, 0, 0}));
+}
+
+// Names and paths are user text: a quote or newline in them must not end a string or start a
+// directive in the SDL. Only numbers from the scene are written, so no quote appears at all.
+TEST(PovWriter, NamesWithQuotesAndNewlinesNeverReachTheSdl) {
+    const std::string evil_path = "dir/we\"ird\n#include \"evil.inc\"\n.yaml";
+    const std::string sdl = sdl_for(
+        "materials:\n"
+        "  \"evil\\\" name\\n#declare Injected = 1;\": {kd: 0.5}\n"
+        "objects:\n"
+        "  - {type: sphere, center: [0, 0, 0], radius: 1, material: \"evil\\\" name\\n#declare Injected = 1;\"}\n",
+        evil_path);
+    EXPECT_THAT(sdl, HasSubstr("sphere {"));
+    EXPECT_THAT(sdl, Not(HasSubstr("\"")));
+    EXPECT_THAT(sdl, Not(HasSubstr("Injected")));
+    EXPECT_THAT(sdl, Not(HasSubstr("evil\" name")));
+    // The scene path may appear, but only inside the one-line comment that opens the file.
+    EXPECT_EQ(sdl.compare(0, 3, "// "), 0);
+    EXPECT_THAT(sdl.substr(0, sdl.find('\n')), HasSubstr("we_ird"));
+    EXPECT_THAT(sdl, Not(HasSubstr("\n#include")));
+    // Every line starting with '#' is one the converter writes itself.
+    for (size_t at = sdl.find("\n#"); at != std::string::npos; at = sdl.find("\n#", at + 1))
+        EXPECT_EQ(sdl.compare(at + 1, 13, "#version 3.7;"), 0) << sdl.substr(at + 1, 40);
+}
+
+// Grey ks (with kd > 0 wherever ka > 0): one texture, pigment kd, ambient ka/kd per channel,
+// diffuse 1, `specular ks roughness 1/p`, reflection km.
+TEST(PovWriter, RecipeAForGreySpecular) {
+    const double ka[3] = {0.08, 0.03, 0.02}, kd[3] = {0.56, 0.21, 0.14}, ks = 0.5, p = 50, km = 0.25;
+    const std::string sdl = sdl_for(
+        "materials:\n  ball: {ka: [0.08, 0.03, 0.02], kd: [0.56, 0.21, 0.14], ks: 0.5, p: 50, km: 0.25}\n"
+        "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, material: ball}\n");
+    EXPECT_EQ(count_of(sdl, "texture {"), 1u);
+    EXPECT_EQ(numbers_after(sdl, "pigment { rgb", 3), (std::vector<double>{kd[0], kd[1], kd[2]}));
+    EXPECT_EQ(numbers_after(sdl, "ambient rgb", 3), (std::vector<double>{ka[0] / kd[0], ka[1] / kd[1], ka[2] / kd[2]}));
+    EXPECT_EQ(numbers_after(sdl, "diffuse", 1)[0], 1.0);
+    EXPECT_EQ(numbers_after(sdl, "specular", 1)[0], ks);
+    EXPECT_EQ(numbers_after(sdl, "roughness", 1)[0], 1 / p);
+    EXPECT_EQ(numbers_after(sdl, "reflection { rgb", 3), (std::vector<double>{km, km, km}));
+    EXPECT_THAT(sdl, HasSubstr("adc_bailout 0"));
+}
+
+// Coloured ks: four layers, bottom first (pov-model §1b with t1 = t2 = 1/2, s = 1):
+// black + specular lobe; filter ks/(t1·t2); diffuse kd/(t1·(1 − t2)) at transmit t2; white at
+// transmit t1 with ambient ka/(1 − t1) and the mirror.
+TEST(PovWriter, RecipeBLayersForColouredSpecular) {
+    const double ka[3] = {0.3, 0.05, 0}, kd[3] = {0, 0.6, 0.8}, ks[3] = {0.9, 0.2, 0.1}, p = 40;
+    const double t1 = 0.5, t2 = 0.5;
+    const std::string sdl = sdl_for(
+        "materials:\n  odd: {ka: [0.3, 0.05, 0], kd: [0, 0.6, 0.8], ks: [0.9, 0.2, 0.1], p: 40, km: [0.2, 0.3, 0.4]}\n"
+        "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, material: odd}\n");
+    std::vector<size_t> layer;  // where each texture starts, in SDL order (bottom layer first)
+    for (size_t at = sdl.find("texture {"); at != std::string::npos; at = sdl.find("texture {", at + 1))
+        layer.push_back(at);
+    ASSERT_EQ(layer.size(), 4u);
+    // L4 (bottom): opaque black, the highlight lobe with strength 1 and exponent p.
+    EXPECT_EQ(numbers_after(sdl, "pigment { rgb", 1, layer[0])[0], 0.0);
+    EXPECT_EQ(numbers_after(sdl, "specular", 1, layer[0])[0], 1.0);
+    EXPECT_EQ(numbers_after(sdl, "roughness", 1, layer[0])[0], 1 / p);
+    // L3: pure filter.
+    EXPECT_EQ(numbers_after(sdl, "rgbf", 4, layer[1]),
+              (std::vector<double>{ks[0] / (t1 * t2), ks[1] / (t1 * t2), ks[2] / (t1 * t2), 1}));
+    // L2: diffuse.
+    EXPECT_EQ(numbers_after(sdl, "rgbt", 4, layer[2]),
+              (std::vector<double>{kd[0] / (t1 * (1 - t2)), kd[1] / (t1 * (1 - t2)), kd[2] / (t1 * (1 - t2)), t2}));
+    // L1 (top): ambient and mirror.
+    EXPECT_EQ(numbers_after(sdl, "rgbt", 4, layer[3]), (std::vector<double>{1, 1, 1, t1}));
+    EXPECT_EQ(numbers_after(sdl, "ambient rgb", 3, layer[3]),
+              (std::vector<double>{ka[0] / (1 - t1), ka[1] / (1 - t1), ka[2] / (1 - t1)}));
+    EXPECT_EQ(numbers_after(sdl, "reflection { rgb", 3, layer[3]), (std::vector<double>{0.2, 0.3, 0.4}));
+    EXPECT_THAT(sdl, HasSubstr("adc_bailout 0"));
+}
+
+// The colour of ks alone decides: ka = 0.1·kd (recipe A could hold it) with a tinted ks still
+// needs the layers, because POV-Ray's `specular` is a single number.
+TEST(PovWriter, TintedSpecularAloneSelectsRecipeB) {
+    const std::string sdl = sdl_for(
+        "materials:\n  tint: {ka: [0.05, 0.05, 0.05], kd: [0.5, 0.5, 0.5], ks: [0.5, 0.5, 0.25], p: 10}\n"
+        "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, material: tint}\n");
+    EXPECT_EQ(count_of(sdl, "texture {"), 4u);
+    EXPECT_EQ(numbers_after(sdl, "rgbf", 4), (std::vector<double>{0.5 / 0.25, 0.5 / 0.25, 0.25 / 0.25, 1}));
+}
+
+// The .ini renders deterministically and linearly (pov-model §0): size, no display, no
+// antialiasing, 16-bit linear PNG.
+TEST(PovWriter, IniIsLinearAndDeterministic) {
+    const SceneDescription d = parse_scene_text(
+        "camera: {eye: [0, 1, 5], look_at: [0, 0, 0]}\nimage: {width: 40, height: 30}\n", "scene.yaml");
+    const std::string ini = pov::ini_for(d, "scene.pov", "scene.png");
+    EXPECT_THAT(ini, HasSubstr("+W40 +H30 -D -A"));
+    EXPECT_THAT(ini, HasSubstr("+FN16"));
+    EXPECT_THAT(ini, HasSubstr("File_Gamma=1.0"));
+    EXPECT_THAT(ini, Not(HasSubstr("+A0")));
+    EXPECT_THROW((void)pov::ini_for(d, "evil\".pov", "scene.png"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace whitted

@@ -1,0 +1,207 @@
+// SPDX-License-Identifier: MIT
+// The lecture's shading model on single hits, against the formula written out by hand:
+//   L = ka·Ia + Σ_i [kd·I_i·(n·l_i) + ks·I_i·max(0, n·h_i)^p] + km·L(r)
+// with the scene-format v1 rules: the n·l gate removes both terms, a shadowed light adds
+// neither, directional lights have l = −direction everywhere.
+
+#include "whitted/render/shading.h"
+#include "whitted/render/accelerator.h"
+#include "whitted/scene/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+namespace whitted {
+namespace {
+
+constexpr double tolerance = 1e-12;
+
+void expect_color_near(const Color& actual, const Color& expected, double tol) {
+    EXPECT_NEAR(actual.x, expected.x, tol);
+    EXPECT_NEAR(actual.y, expected.y, tol);
+    EXPECT_NEAR(actual.z, expected.z, tol);
+}
+
+// The floor y = 0 seen from (0, 1, 1) through the origin: at the hit n = (0, 1, 0) and
+// v = (0, 1, 1)/√2.
+const Vec3 eye{0, 1, 1};
+const Vec3 up_normal{0, 1, 0};
+const Vec3 to_eye = normalize(eye);
+
+Scene floor_scene(const Material& material) {
+    Scene scene;
+    scene.width = scene.height = 1;
+    scene.max_depth = 5;
+    scene.ambient = Color(1.0);
+    scene.background = Color(0.0);
+    scene.materials = {material};
+    scene.planes = {{Vec3{0, 0, 0}, up_normal, 0}};
+    return scene;
+}
+
+Material material(const Color& ka, const Color& kd, const Color& ks, double p, Highlight highlight = Highlight::blinn) {
+    return {ka, kd, ks, p, Color(0.0), highlight};
+}
+
+Light point_light(const Vec3& position, const Color& intensity) {
+    return {LightType::point, position, {}, intensity};
+}
+
+Light directional_light(const Vec3& direction, const Color& intensity) {
+    return {LightType::directional, {}, -normalize(direction), intensity};
+}
+
+Color trace_from(const Scene& scene, const Vec3& origin, const Vec3& target) {
+    const Accelerator accelerator(scene);
+    const LectureShading shading(scene, accelerator);
+    RayCounts counts;
+    return shading.trace({origin, normalize(target - origin), 1e-4, 1e7}, 0, counts);
+}
+
+TEST(Shading, AmbientAloneIsKaTimesIaPerChannel) {
+    Scene scene = floor_scene(material({0.2, 0.3, 0.4}, Color(1.0), Color(1.0), 10));
+    scene.ambient = {0.5, 1.0, 2.0};
+    expect_color_near(trace_from(scene, eye, {0, 0, 0}), {0.2 * 0.5, 0.3 * 1.0, 0.4 * 2.0}, tolerance);
+}
+
+// Light at (1, 2, 0) over the origin: l = (1, 2, 0)/√5, so n·l = 2/√5; the Blinn half vector is
+// l + v = (1/√5, 2/√5 + 1/√2, 1/√2) normalised.
+TEST(Shading, DiffusePlusBlinnHighlightInClosedForm) {
+    const Color ka{0.05, 0.1, 0.15}, kd{0.3, 0.6, 0.9}, intensity{1, 0.5, 0.25};
+    const double ks = 0.4, p = 7;
+    Scene scene = floor_scene(material(ka, kd, Color(ks), p));
+    scene.lights = {point_light({1, 2, 0}, intensity)};
+    const double s5 = std::sqrt(5.0), s2 = std::sqrt(2.0);
+    const double n_dot_l = 2 / s5;
+    const Vec3 half{1 / s5, 2 / s5 + 1 / s2, 1 / s2};
+    const double n_dot_h = half.y / length(half);
+    const Color expected = ka + kd * intensity * n_dot_l + intensity * (ks * std::pow(n_dot_h, p));
+    expect_color_near(trace_from(scene, eye, {0, 0, 0}), expected, tolerance);
+}
+
+// highlight: phong uses the mirrored view r_v = (0, 1, −1)/√2, so r_v·l = 2/√10.
+TEST(Shading, PhongHighlightUsesMirroredViewRay) {
+    const Color kd{0.2, 0.2, 0.2}, intensity{1, 1, 1};
+    const double ks = 0.7, p = 3;
+    Scene scene = floor_scene(material(Color(0.0), kd, Color(ks), p, Highlight::phong));
+    scene.lights = {point_light({1, 2, 0}, intensity)};
+    const double expected = 0.2 * (2 / std::sqrt(5.0)) + ks * std::pow(2 / std::sqrt(10.0), p);
+    expect_color_near(trace_from(scene, eye, {0, 0, 0}), Color(expected), tolerance);
+}
+
+// A light below the floor: n·l < 0, so neither diffuse nor highlight, although the lecture's
+// max(0, n·h)^p alone would still be positive here.
+TEST(Shading, LightBehindSurfaceRemovesHighlightToo) {
+    const Material m = material({0.1, 0.2, 0.3}, Color(1.0), Color(1.0), 1);
+    Scene scene = floor_scene(m);
+    const Vec3 light{3, -0.5, -1};
+    scene.lights = {point_light(light, Color(1.0))};
+    const Vec3 to_light = normalize(light);
+    ASSERT_LT(dot(up_normal, to_light), 0);
+    ASSERT_GT(LectureShading::specular_lobe(m, up_normal, to_eye, to_light), 0.1);  // what the gate must remove
+    expect_color_near(trace_from(scene, eye, {0, 0, 0}), {0.1, 0.2, 0.3}, tolerance);
+}
+
+// A sphere between the hit and a light straight above: that light adds neither term. A sphere
+// beyond the light, or the same light unblocked, shows what the light would have added.
+TEST(Shading, ShadowedLightAddsNeitherTerm) {
+    const Color ka{0.1, 0.2, 0.3}, kd{0.5, 0.5, 0.5};
+    const double ks = 0.5, p = 4;
+    Scene scene = floor_scene(material(ka, kd, Color(ks), p));
+    scene.lights = {point_light({0, 5, 0}, Color(1.0))};
+    scene.spheres = {{Transform(), {0, 2.5, 0}, 0.5, 0}};
+    expect_color_near(trace_from(scene, eye, {0, 0, 0}), ka, tolerance);
+
+    // l = (0, 1, 0): n·l = 1, n·h = (1 + 1/√2)/|(0, 1 + 1/√2, 1/√2)|.
+    const double s2 = std::sqrt(2.0);
+    const double n_dot_h = (1 + 1 / s2) / length(Vec3{0, 1 + 1 / s2, 1 / s2});
+    const Color lit = ka + kd + Color(ks * std::pow(n_dot_h, p));
+    scene.spheres = {{Transform(), {0, 7, 0}, 0.5, 0}};  // beyond the light: no shadow
+    expect_color_near(trace_from(scene, eye, {0, 0, 0}), lit, tolerance);
+    scene.spheres.clear();
+    expect_color_near(trace_from(scene, eye, {0, 0, 0}), lit, tolerance);
+}
+
+// Directional light: l = −direction/|direction| at every point, so two different hits on the
+// floor get the same diffuse kd·I·(n·l) with n·l = 2/|(−1, 2, −0.5)|.
+TEST(Shading, DirectionalLightIsTheSameEverywhere) {
+    const Color kd{0.8, 0.4, 0.2}, intensity{0.5, 1.0, 1.5};
+    Scene scene = floor_scene(material(Color(0.0), kd, Color(0.0), 1));
+    scene.lights = {directional_light({1, -2, 0.5}, intensity)};
+    const Color expected = kd * intensity * (2 / length(Vec3{-1, 2, -0.5}));
+    expect_color_near(trace_from(scene, eye, {0, 0, 0}), expected, tolerance);
+    expect_color_near(trace_from(scene, {10, 1, -3}, {10, 0, -4}), expected, tolerance);
+    expect_color_near(trace_from(scene, {-300, 2, 50}, {-290, 0, 45}), expected, tolerance);
+}
+
+// A directional light is shadowed by anything up-beam of the point, however far.
+TEST(Shading, DirectionalLightIsShadowed) {
+    const Color ka{0.01, 0.02, 0.03};
+    Scene scene = floor_scene(material(ka, Color(1.0), Color(1.0), 5));
+    const Vec3 direction{1, -2, 0.5};
+    scene.lights = {directional_light(direction, Color(1.0))};
+    const Vec3 up_beam = -normalize(direction) * 100.0;  // 100 units toward the light from the origin
+    scene.spheres = {{Transform(), up_beam, 1.0, 0}};
+    expect_color_near(trace_from(scene, eye, {0, 0, 0}), ka, tolerance);
+}
+
+// With n = +y, v at angle a on one side and l at angle b on the other, in one plane:
+// n·h = cos((a − b)/2) and r_v·l = cos(a − b). So Blinn gives cos((a−b)/2)^p, Phong cos(a−b)^p.
+TEST(Shading, BlinnAndPhongLobesInClosedForm) {
+    const double a = 60 * std::numbers::pi / 180, b = 20 * std::numbers::pi / 180, p = 10;
+    const Vec3 v{std::sin(a), std::cos(a), 0}, l{-std::sin(b), std::cos(b), 0};
+    const Material blinn = material({}, {}, Color(1.0), p, Highlight::blinn);
+    const Material phong = material({}, {}, Color(1.0), p, Highlight::phong);
+    EXPECT_NEAR(LectureShading::specular_lobe(blinn, up_normal, v, l), std::pow(std::cos((a - b) / 2), p), 1e-14);
+    EXPECT_NEAR(LectureShading::specular_lobe(phong, up_normal, v, l), std::pow(std::cos(a - b), p), 1e-14);
+    // Light exactly along the mirrored view ray: both lobes peak at 1.
+    const Vec3 mirrored{-std::sin(a), std::cos(a), 0};
+    EXPECT_NEAR(LectureShading::specular_lobe(blinn, up_normal, v, mirrored), 1.0, 1e-14);
+    EXPECT_NEAR(LectureShading::specular_lobe(phong, up_normal, v, mirrored), 1.0, 1e-14);
+}
+
+// Light and eye together at 80° from n: r_v·l = cos 160° < 0, so Phong gives 0, while h = v
+// and Blinn gives cos(80°)^p.
+TEST(Shading, PhongLobeClampsAtZeroWhereBlinnDoesNot) {
+    const double a = 80 * std::numbers::pi / 180, p = 2;
+    const Vec3 v{std::sin(a), std::cos(a), 0};
+    const Material blinn = material({}, {}, Color(1.0), p, Highlight::blinn);
+    const Material phong = material({}, {}, Color(1.0), p, Highlight::phong);
+    EXPECT_EQ(LectureShading::specular_lobe(phong, up_normal, v, v), 0.0);
+    EXPECT_NEAR(LectureShading::specular_lobe(blinn, up_normal, v, v), std::pow(std::cos(a), p), 1e-14);
+}
+
+// Surfaces are two-sided: the floor seen from below, lit from below, shades like from above.
+TEST(Shading, BackFaceIsLitFromItsOwnSide) {
+    const Color kd{0.3, 0.6, 0.9};
+    Scene scene = floor_scene(material(Color(0.0), kd, Color(0.0), 1));
+    scene.lights = {point_light({1, -2, 0}, Color(1.0))};
+    expect_color_near(trace_from(scene, {0, -1, 1}, {0, 0, 0}), kd * (2 / std::sqrt(5.0)), tolerance);
+}
+
+// Two lights add; the second one here has n·l = 1/√2 (light at (0, 1, −1)).
+TEST(Shading, LightsAdd) {
+    const Color kd{0.5, 0.25, 0.125};
+    Scene scene = floor_scene(material(Color(0.0), kd, Color(0.0), 1));
+    scene.lights = {point_light({1, 2, 0}, {1, 0, 0}), point_light({0, 1, -1}, {0, 1, 1})};
+    const Color expected = kd * Color{1, 0, 0} * (2 / std::sqrt(5.0)) + kd * Color{0, 1, 1} * (1 / std::sqrt(2.0));
+    expect_color_near(trace_from(scene, eye, {0, 0, 0}), expected, tolerance);
+}
+
+// Rays that hit nothing return the background; max_depth 1 allows no mirror bounce at all.
+TEST(Shading, MissGivesBackgroundAndMaxDepthOneHasNoMirror) {
+    Material mirror = material({0.1, 0.1, 0.1}, Color(0.0), Color(0.0), 1);
+    mirror.km = Color(0.5);
+    Scene scene = floor_scene(mirror);
+    scene.background = {0.2, 0.4, 0.6};
+    expect_color_near(trace_from(scene, eye, {0, 2, 0}), scene.background, 0.0);  // looking up: no hit
+    // One bounce: ka + km·background.
+    expect_color_near(trace_from(scene, eye, {0, 0, 0}), Color{0.1, 0.1, 0.1} + Color{0.1, 0.2, 0.3}, tolerance);
+    scene.max_depth = 1;
+    expect_color_near(trace_from(scene, eye, {0, 0, 0}), Color(0.1), tolerance);
+}
+
+}  // namespace
+}  // namespace whitted

@@ -1,0 +1,190 @@
+// SPDX-License-Identifier: MIT
+// Ray–shape intersection in closed form: distances from elementary geometry, normals from the
+// shapes' definitions (for a transformed sphere, the gradient of its implicit equation).
+
+#include "whitted/geometry/shapes.h"
+#include "whitted/core/transform.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace whitted {
+namespace {
+
+constexpr double t_min = 1e-4, t_max = 1e7;
+
+Ray ray_from(const Vec3& origin, const Vec3& direction) {
+    return {origin, normalize(direction), t_min, t_max};
+}
+
+void expect_vec_near(const Vec3& actual, const Vec3& expected, double tol) {
+    EXPECT_NEAR(actual.x, expected.x, tol);
+    EXPECT_NEAR(actual.y, expected.y, tol);
+    EXPECT_NEAR(actual.z, expected.z, tol);
+}
+
+TEST(Sphere, HitFromOutsideHeadOn) {
+    const Sphere sphere{Transform(), {1, 2, 3}, 2, 0};
+    ShapeHit hit;
+    ASSERT_TRUE(intersect_sphere(sphere, ray_from({1, 2, 10}, {0, 0, -1}), t_min, t_max, hit));
+    EXPECT_NEAR(hit.t, 10.0 - 3.0 - 2.0, 1e-12);  // from z = 10 to the near pole at z = 3 + 2
+    expect_vec_near(normalize(hit.normal), {0, 0, 1}, 1e-12);
+}
+
+// Aimed at the centre of a sphere at (5, 5, 0) from the origin: the near surface is r short of
+// the centre's distance 5√2.
+TEST(Sphere, HitFromOutsideOblique) {
+    const Sphere sphere{Transform(), {5, 5, 0}, 1, 0};
+    ShapeHit hit;
+    ASSERT_TRUE(intersect_sphere(sphere, ray_from({0, 0, 0}, {1, 1, 0}), t_min, t_max, hit));
+    EXPECT_NEAR(hit.t, 5 * std::sqrt(2.0) - 1, 1e-12);
+    expect_vec_near(normalize(hit.normal), normalize(Vec3{-1, -1, 0}), 1e-12);
+}
+
+// From the centre the ray meets the far side at t = r, and the normal is still the outward one
+// (turning it toward the ray is the shader's job).
+TEST(Sphere, HitFromInsideReturnsFarSideWithOutwardNormal) {
+    const Sphere sphere{Transform(), {0, 0, 0}, 3, 0};
+    ShapeHit hit;
+    ASSERT_TRUE(intersect_sphere(sphere, ray_from({0, 0, 0}, {0, 1, 0}), t_min, t_max, hit));
+    EXPECT_NEAR(hit.t, 3.0, 1e-12);
+    expect_vec_near(normalize(hit.normal), {0, 1, 0}, 1e-12);
+    // Off-centre inside: from (0, 1, 0) upward the far side is 2 away.
+    ASSERT_TRUE(intersect_sphere(sphere, ray_from({0, 1, 0}, {0, 1, 0}), t_min, t_max, hit));
+    EXPECT_NEAR(hit.t, 2.0, 1e-12);
+}
+
+TEST(Sphere, MissesBehindBesideAndBeyondRange) {
+    const Sphere sphere{Transform(), {0, 0, -5}, 1, 0};
+    ShapeHit hit;
+    EXPECT_FALSE(intersect_sphere(sphere, ray_from({0, 0, 0}, {0, 0, 1}), t_min, t_max, hit));      // behind
+    EXPECT_FALSE(intersect_sphere(sphere, ray_from({1.01, 0, 0}, {0, 0, -1}), t_min, t_max, hit));  // beside
+    EXPECT_FALSE(intersect_sphere(sphere, ray_from({0, 0, 0}, {0, 0, -1}), t_min, 3.9, hit));       // t_max < 4
+    EXPECT_TRUE(intersect_sphere(sphere, ray_from({0, 0, 0}, {0, 0, -1}), t_min, 4.1, hit));
+}
+
+// The unit sphere scaled by (2, 1, 1) is the ellipsoid x²/4 + y² + z² = 1, whose normal is the
+// gradient ∝ (x/4, y, z): the inverse transpose of the scale, not the scaled radius vector.
+TEST(Sphere, NonUniformScaleUsesInverseTransposeNormal) {
+    const Sphere sphere{Transform::scale({2, 1, 1}).then(Transform::translate({0, 3, 0})), {0, 0, 0}, 1, 0};
+    ShapeHit hit;
+    // Along x = 1, y = 3 (object y = 0): 1/4 + z² = 1 gives z = √3/2 on the near side.
+    ASSERT_TRUE(intersect_sphere(sphere, ray_from({1, 3, 10}, {0, 0, -1}), t_min, t_max, hit));
+    const double z = std::sqrt(3.0) / 2;
+    EXPECT_NEAR(hit.t, 10 - z, 1e-12);
+    const Vec3 gradient_normal = normalize(Vec3{1.0 / 4, 0, z});
+    expect_vec_near(normalize(hit.normal), gradient_normal, 1e-12);
+    // The naive normal (hit − centre) would be (1, 0, √3/2) normalised: clearly different.
+    EXPECT_GT(length(normalize(Vec3{1, 0, z}) - gradient_normal), 0.1);
+}
+
+TEST(Sphere, WorldBoundsOfScaledSphere) {
+    const Sphere sphere{Transform::scale({2, 1, 0.5}).then(Transform::translate({1, 1, 1})), {0, 0, 0}, 1, 0};
+    Vec3 lo, hi;
+    world_bounds(sphere, lo, hi);
+    expect_vec_near(lo, {-1, 0, 0.5}, 1e-12);
+    expect_vec_near(hi, {3, 2, 1.5}, 1e-12);
+}
+
+// A ray toward the centre from outside each of the six faces of a non-cubic box hits that face
+// at (5 − half-extent) with that face's outward normal.
+TEST(Box, EachFaceFromOutside) {
+    const Box box{Transform(), {-1, -2, -3}, {1, 2, 3}, 0};
+    const Vec3 half{1, 2, 3};
+    for (int axis = 0; axis < 3; ++axis) {
+        for (const double sign : {-1.0, 1.0}) {
+            Vec3 outward;
+            outward[axis] = sign;
+            ShapeHit hit;
+            ASSERT_TRUE(intersect_box(box, ray_from(outward * 5, -outward), t_min, t_max, hit))
+                << "axis " << axis << " sign " << sign;
+            EXPECT_NEAR(hit.t, 5 - half[axis], 1e-12) << "axis " << axis << " sign " << sign;
+            expect_vec_near(hit.normal, outward, 0.0);
+        }
+    }
+}
+
+TEST(Box, FromInsideHitsTheExitFace) {
+    const Box box{Transform(), {-1, -1, -1}, {1, 1, 1}, 0};
+    ShapeHit hit;
+    ASSERT_TRUE(intersect_box(box, ray_from({0.5, 0, 0}, {1, 0, 0}), t_min, t_max, hit));
+    EXPECT_NEAR(hit.t, 0.5, 1e-12);
+    expect_vec_near(hit.normal, {1, 0, 0}, 0.0);
+    // From (0, 0, 0.5) down −z: the exit face is z = −1, 1.5 away, with normal −z.
+    ASSERT_TRUE(intersect_box(box, ray_from({0, 0, 0.5}, {0, 0, -1}), t_min, t_max, hit));
+    EXPECT_NEAR(hit.t, 1.5, 1e-12);
+    expect_vec_near(hit.normal, {0, 0, -1}, 0.0);
+}
+
+TEST(Box, MissesParallelOutsideSlabAndBehind) {
+    const Box box{Transform(), {-1, -1, -1}, {1, 1, 1}, 0};
+    ShapeHit hit;
+    EXPECT_FALSE(intersect_box(box, ray_from({0, 1.5, 5}, {0, 0, -1}), t_min, t_max, hit));  // above the y slab
+    EXPECT_FALSE(intersect_box(box, ray_from({0, 0, 5}, {0, 0, 1}), t_min, t_max, hit));     // box behind
+    EXPECT_FALSE(intersect_box(box, ray_from({3, 0, 6}, {-1, 0, -1}), t_min, t_max, hit));   // passes beside
+}
+
+// A box turned 90° about z: its object x face now faces world +y, with the normal carried along.
+TEST(Box, RotatedBoxNormalFollowsTransform) {
+    const Box box{Transform::rotate({0, 0, 1}, 90), {-1, -2, -3}, {1, 2, 3}, 0};
+    ShapeHit hit;
+    // World +y extent is the object x extent (1).
+    ASSERT_TRUE(intersect_box(box, ray_from({0, 10, 0}, {0, -1, 0}), t_min, t_max, hit));
+    EXPECT_NEAR(hit.t, 9.0, 1e-12);
+    expect_vec_near(normalize(hit.normal), {0, 1, 0}, 1e-12);
+    // World +x extent is the object y extent (2).
+    ASSERT_TRUE(intersect_box(box, ray_from({10, 0, 0}, {-1, 0, 0}), t_min, t_max, hit));
+    EXPECT_NEAR(hit.t, 8.0, 1e-12);
+    expect_vec_near(normalize(hit.normal), {1, 0, 0}, 1e-12);
+}
+
+TEST(Plane, HitAtClosedFormDistance) {
+    const Plane plane{{0, -1, 0}, {0, 1, 0}, 0};
+    ShapeHit hit;
+    // From y = 1 at 45° down: 2 down and 2 across, t = 2√2.
+    ASSERT_TRUE(intersect_plane(plane, ray_from({0, 1, 0}, {1, -1, 0}), t_min, t_max, hit));
+    EXPECT_NEAR(hit.t, 2 * std::sqrt(2.0), 1e-12);
+    expect_vec_near(hit.normal, {0, 1, 0}, 0.0);
+    // From below, the same plane is hit on its back; the normal stays the plane's own.
+    ASSERT_TRUE(intersect_plane(plane, ray_from({0, -4, 0}, {0, 1, 0}), t_min, t_max, hit));
+    EXPECT_NEAR(hit.t, 3.0, 1e-12);
+    expect_vec_near(hit.normal, {0, 1, 0}, 0.0);
+}
+
+TEST(Plane, ParallelAndBehindMiss) {
+    const Plane plane{{0, -1, 0}, {0, 1, 0}, 0};
+    ShapeHit hit;
+    EXPECT_FALSE(intersect_plane(plane, ray_from({0, 1, 0}, {1, 0, 0}), t_min, t_max, hit));   // parallel above
+    EXPECT_FALSE(intersect_plane(plane, ray_from({0, -1, 0}, {0, 0, 1}), t_min, t_max, hit));  // parallel, in it
+    EXPECT_FALSE(intersect_plane(plane, ray_from({0, 1, 0}, {0, 1, 0}), t_min, t_max, hit));   // plane behind
+}
+
+// Barycentrics: the point (1 − u − v)·v0 + u·v1 + v·v2 must come back as (u, v).
+TEST(Triangle, BarycentricsOfAKnownPoint) {
+    const Vec3 v0{1, 0, 0}, v1{0, 2, 0}, v2{0, 0, 3};
+    const double u = 0.3, v = 0.5;
+    const Vec3 target = v0 * (1 - u - v) + v1 * u + v2 * v;
+    const Vec3 direction = normalize(Vec3{-1, -2, -0.5});
+    ShapeHit hit;
+    ASSERT_TRUE(intersect_triangle(v0, v1, v2, {target - direction * 2.5, direction, t_min, t_max}, t_min, t_max, hit));
+    EXPECT_NEAR(hit.t, 2.5, 1e-12);
+    EXPECT_NEAR(hit.u, u, 1e-12);
+    EXPECT_NEAR(hit.v, v, 1e-12);
+    expect_vec_near(hit.normal, cross(v1 - v0, v2 - v0), 1e-12);
+    EXPECT_GT(dot(hit.normal, Vec3{1, 1, 1}), 0);  // (v1 − v0) × (v2 − v0) points away from the origin here
+}
+
+TEST(Triangle, MissesOutsideEdgesAndWhenParallel) {
+    const Vec3 v0{0, 0, 0}, v1{1, 0, 0}, v2{0, 1, 0};
+    ShapeHit hit;
+    EXPECT_FALSE(intersect_triangle(v0, v1, v2, ray_from({0.6, 0.6, 1}, {0, 0, -1}), t_min, t_max, hit));  // u+v>1
+    EXPECT_FALSE(intersect_triangle(v0, v1, v2, ray_from({-0.1, 0.5, 1}, {0, 0, -1}), t_min, t_max, hit));
+    EXPECT_FALSE(intersect_triangle(v0, v1, v2, ray_from({0.2, 0.2, 1}, {1, 0, 0}), t_min, t_max, hit));  // parallel
+    EXPECT_FALSE(intersect_triangle(v0, v1, v2, ray_from({0.2, 0.2, 1}, {0, 0, 1}), t_min, t_max, hit));  // behind
+    ASSERT_TRUE(intersect_triangle(v0, v1, v2, ray_from({0.2, 0.2, -1}, {0, 0, 1}), t_min, t_max, hit));  // back face
+    EXPECT_NEAR(hit.t, 1.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace whitted
