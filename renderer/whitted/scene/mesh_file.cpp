@@ -6,6 +6,7 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <unordered_map>
 
@@ -40,8 +41,23 @@ MeshData load_obj_mesh(const std::string& path, const SourceLocation& referenced
     const size_t position_count = attrib.vertices.size() / 3;
     const size_t normal_count = attrib.normals.size() / 3;
 
+    // tinyobjloader reads values beyond float range as inf; Embree's results are undefined for
+    // non-finite vertices, and a NaN colour passes every range check.
+    const auto require_finite = [&](const std::vector<tinyobj::real_t>& values, const char* what) {
+        for (size_t i = 0; i < values.size(); ++i)
+            if (!std::isfinite(values[i]))
+                throw InputError({path}, std::string(what) + " " + std::to_string(i / 3 + 1) +
+                                             " has a coordinate that is not a finite number (beyond float range?)");
+    };
+    require_finite(attrib.vertices, "vertex");
+    require_finite(attrib.normals, "normal");
+
     MeshData mesh;
     for (const tinyobj::material_t& m : reader.GetMaterials()) {
+        for (const tinyobj::real_t value : {m.ambient[0], m.ambient[1], m.ambient[2], m.diffuse[0], m.diffuse[1],
+                                            m.diffuse[2], m.specular[0], m.specular[1], m.specular[2], m.shininess})
+            if (!std::isfinite(value))
+                throw InputError({path}, "material '" + m.name + "' has a value that is not a finite number");
         MaterialDescription material;
         material.name = m.name;
         material.where = {path};
