@@ -143,7 +143,17 @@ private:
     }
 
     void add_mesh_file(const ObjectDescription& object, const Transform& to_world) {
-        MeshData data = load_obj_mesh(object.file_path, object.file.where);
+        // A mistake inside the OBJ/MTL names that file; also say which scene line loads it.
+        const auto with_reference = [&](const InputError& e) {
+            return InputError(e.where(), e.message() + " (mesh loaded at " + object.file.where.str() + ")");
+        };
+        MeshData data;
+        try {
+            data = load_obj_mesh(object.file_path, object.file.where);
+        } catch (const InputError& e) {
+            if (e.where().file == object.file.where.file) throw;
+            throw with_reference(e);
+        }
         TriangleMesh mesh;
         if (object.material) {
             mesh.material = resolve_material(object);
@@ -151,8 +161,12 @@ private:
             std::vector<uint32_t> mtl_index;
             for (size_t i = 0; i < data.materials.size(); ++i) {
                 mtl_index.push_back(static_cast<uint32_t>(m_scene.materials.size()));
-                m_scene.materials.push_back(
-                    make_material(data.materials[i], object.file_path + ": material '" + data.materials[i].name + "'"));
+                try {
+                    m_scene.materials.push_back(make_material(
+                        data.materials[i], object.file_path + ": material '" + data.materials[i].name + "'"));
+                } catch (const InputError& e) {
+                    throw with_reference(e);
+                }
             }
             for (const int32_t m : data.triangle_material) {
                 if (m < 0)
