@@ -46,6 +46,41 @@ extern "C" void on_signal(int signal) {
     g_cancel.store(true);
 }
 
+/// Workers look at g_cancel only between tiles, and one tile of a legal scene (16x16 pixels,
+/// 256 samples each, 256 mirror bounces, many lights) can take minutes. Nothing is written
+/// while rendering, so if the render has not returned a second after a signal this ends the
+/// program: the previous output is untouched and there is no temporary file yet.
+class CancelWatchdog {
+public:
+    CancelWatchdog()
+        : m_thread([this] {
+              while (!m_done.load()) {
+                  if (g_cancel.load()) {
+                      const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(900);
+                      while (!m_done.load() && std::chrono::steady_clock::now() < deadline)
+                          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+                      if (m_done.load()) return;
+                      std::fprintf(stderr,
+                                   "whitted: interrupted; a tile did not finish within a second, "
+                                   "stopped without writing anything\n");
+                      std::fflush(stderr);
+                      ::_exit(128 + g_signal.load());
+                  }
+                  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+              }
+          }) {}
+    ~CancelWatchdog() {
+        m_done.store(true);
+        m_thread.join();
+    }
+    CancelWatchdog(const CancelWatchdog&) = delete;
+    CancelWatchdog& operator=(const CancelWatchdog&) = delete;
+
+private:
+    std::atomic<bool> m_done{false};
+    std::thread m_thread;
+};
+
 void install_signal_handlers() {
     struct sigaction action {};
     action.sa_handler = on_signal;
@@ -134,7 +169,11 @@ int run_render(const RenderArguments& args) {
         options.cancel = &g_cancel;
         if (!args.quiet && ::isatty(STDERR_FILENO)) options.on_progress = draw_progress;
         g_exit_on_signal.store(false);  // from here on a signal cancels, and we clean up
-        RenderResult result = render(scene, accelerator, options);
+        RenderResult result;
+        {
+            const CancelWatchdog watchdog;
+            result = render(scene, accelerator, options);
+        }
         if (options.on_progress) std::fputc('\n', stderr);
         timer.lap();
 
