@@ -7,7 +7,6 @@ find_package(PkgConfig REQUIRED)
 find_package(embree 3 CONFIG REQUIRED)
 find_package(TBB CONFIG REQUIRED)
 find_package(yaml-cpp CONFIG REQUIRED)
-find_package(tinyobjloader CONFIG REQUIRED)  # no version: Debian's reports "2rc10"
 find_package(CLI11 CONFIG REQUIRED)
 find_package(fmt CONFIG REQUIRED)
 find_package(nlohmann_json CONFIG REQUIRED)
