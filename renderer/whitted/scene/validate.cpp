@@ -100,7 +100,7 @@ private:
                 mesh.material = resolve_material(object);
                 for (const Vec3& v : object.vertices) push_position(mesh, to_world.apply_point(v));
                 mesh.indices = {0, 1, 2};
-                m_scene.meshes.push_back(std::move(mesh));
+                add_mesh(std::move(mesh), object.vertices_where);
                 break;
             }
             case ObjectType::mesh:
@@ -139,7 +139,7 @@ private:
                 fail(object.normals_where, "mesh.normals[" + std::to_string(i) + "] must not be the zero vector");
             push_normal(mesh, to_world.apply_normal(object.normals[i]));
         }
-        m_scene.meshes.push_back(std::move(mesh));
+        add_mesh(std::move(mesh), object.vertices_where);
     }
 
     void add_mesh_file(const ObjectDescription& object, const Transform& to_world) {
@@ -188,6 +188,16 @@ private:
                                       {data.normals[3 * i], data.normals[3 * i + 1], data.normals[3 * i + 2]}));
         }
         mesh.indices = std::move(data.indices);
+        add_mesh(std::move(mesh), object.file.where);
+    }
+
+    /// Triangles are stored as float for Embree, whose results are undefined for non-finite
+    /// vertices: a coordinate beyond float range (given, or after the transform) is refused.
+    void add_mesh(TriangleMesh mesh, const SourceLocation& where) {
+        for (size_t i = 0; i < mesh.positions.size(); ++i)
+            if (!std::isfinite(mesh.positions[i]))
+                fail(where, "vertex " + std::to_string(i / 4) +
+                                " is beyond float range (about 3.4e38) once transformed to world space");
         m_scene.meshes.push_back(std::move(mesh));
     }
 
