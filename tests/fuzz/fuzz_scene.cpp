@@ -7,6 +7,7 @@
 #include "whitted/scene/description.h"
 #include "whitted/scene/scene.h"
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -21,9 +22,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         const Scene scene = validate_scene(description);
         // The renderer trusts these; a validated scene breaking them is a validator bug.
         if (scene.width < 1 || scene.height < 1 || scene.samples < 1 || scene.max_depth < 1) __builtin_trap();
-        for (const TriangleMesh& mesh : scene.meshes)
+        for (const TriangleMesh& mesh : scene.meshes) {
             for (const uint32_t index : mesh.indices)
                 if (index >= mesh.vertex_count()) __builtin_trap();
+            for (const float value : mesh.positions)
+                if (!std::isfinite(value)) __builtin_trap();  // Embree needs finite vertices
+        }
     } catch (const InputError&) {
         // A refusal with a location: what every bad scene should get.
     }

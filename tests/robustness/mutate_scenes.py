@@ -84,6 +84,7 @@ def main():
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--timeout", type=float, default=20)
     parser.add_argument("--keep", help="copy failing scenes here")
+    parser.add_argument("--no-shrink", action="store_true", help="mutate the examples at their own image size")
     args = parser.parse_args()
 
     seeds = sorted(glob.glob(os.path.join(args.source_dir, "examples", "**", "*.yaml"), recursive=True))
@@ -94,7 +95,9 @@ def main():
     # Mesh files the seeds name, beside the mutated scenes.
     for mesh in glob.glob(os.path.join(args.source_dir, "examples", "meshes", "*.[om][bt][jl]")):
         shutil.copy(mesh, work)
-    texts = [(os.path.basename(s), shrink(open(s, "rb").read())) for s in seeds]
+    texts = [(os.path.basename(s), open(s, "rb").read()) for s in seeds]
+    if not args.no_shrink:
+        texts = [(name, shrink(text)) for name, text in texts]
     env = dict(os.environ)
     env["ASAN_OPTIONS"] = env.get("ASAN_OPTIONS", "detect_leaks=1") + ":allocator_may_return_null=1"
     codes, failures, slow = {}, [], []
@@ -116,8 +119,10 @@ def main():
             try:
                 _, stderr = process.communicate(timeout=2)
                 if process.returncode == 130:
-                    size = re.search(rb"width: *(\S+).*?height: *(\S+)", mutated, re.S)
-                    slow.append((n, name, size.groups() if size else "?"))
+                    size = re.search(rb"width: *([^,}\s]+).*?height: *([^,}\s]+)", mutated, re.S)
+                    samples = re.search(rb"samples: *([^,}\s]+)", mutated)
+                    depth = re.search(rb"max_depth: *([^,}\s]+)", mutated)
+                    slow.append((n, name, [m.groups() if m else None for m in (size, samples, depth)]))
                 else:
                     problem = f"slow, then exit {process.returncode} after SIGINT"
             except subprocess.TimeoutExpired:
@@ -150,7 +155,7 @@ def main():
     elapsed = time.monotonic() - start
     print(f"mutate_scenes: {args.count} mutants of {len(texts)} scenes in {elapsed:.1f} s; exit codes {codes}")
     for n, name, size in slow:
-        print(f"  slow but legal (stopped by SIGINT): mutant {n} of {name}, image {size}")
+        print(f"  slow but legal (stopped by SIGINT): mutant {n} of {name}, (width, height), samples, max_depth: {size}")
     for n, name, problem, err in failures:
         print(f"FAIL mutant {n} of {name}: {problem}\n{err}")
     sys.exit(1 if failures else 0)
