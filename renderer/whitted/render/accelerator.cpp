@@ -15,12 +15,13 @@ namespace {
 
 enum class ShapeKind : uint32_t { triangles, spheres, boxes };
 
-/// Embree's context, extended with the double-precision ray: user-geometry callbacks read it
-/// back from the pointer Embree passes them, so spheres and boxes never see the float copy.
+/// Embree's context, extended with the double-precision rays of the query: user-geometry
+/// callbacks read them back from the pointer Embree passes them (Embree's ray `id` is the index
+/// into `rays`), so spheres and boxes never see the float copies.
 struct QueryContext {
     RTCIntersectContext embree;
-    const Ray* ray = nullptr;
-    double best_t = 0;  ///< nearest analytic hit so far (double), for intersect queries
+    const Ray* rays = nullptr;
+    double best_t[Accelerator::packet_size] = {};  ///< nearest analytic hit so far per ray (double)
 };
 
 struct AnalyticGeometry {
@@ -54,33 +55,40 @@ void analytic_bounds(const RTCBoundsFunctionArguments* args) {
 }
 
 void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
-    if (args->N != 1 || !args->valid[0]) return;  // we only issue single-ray queries
     const auto* geometry = static_cast<const AnalyticGeometry*>(args->geometryUserPtr);
     auto* context = reinterpret_cast<QueryContext*>(args->context);
-    auto* rayhit = reinterpret_cast<RTCRayHit*>(args->rayhit);
-    const double limit = std::min(context->best_t, double(rayhit->ray.tfar));
-    ShapeHit hit;
-    if (!intersect_analytic(*geometry, args->primID, *context->ray, limit, hit)) return;
-    context->best_t = hit.t;
-    // Round the float distance up so Embree keeps visiting boxes that may hold a closer hit.
-    rayhit->ray.tfar = std::nextafter(float(hit.t), INFINITY);
-    rayhit->hit.geomID = args->geomID;
-    rayhit->hit.primID = args->primID;
-    rayhit->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rayhit->hit.u = rayhit->hit.v = 0;
-    rayhit->hit.Ng_x = float(hit.normal.x);
-    rayhit->hit.Ng_y = float(hit.normal.y);
-    rayhit->hit.Ng_z = float(hit.normal.z);
+    RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, args->N);
+    RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, args->N);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (!args->valid[i]) continue;
+        const unsigned id = RTCRayN_id(rays, args->N, i);
+        const double limit = std::min(context->best_t[id], double(RTCRayN_tfar(rays, args->N, i)));
+        ShapeHit hit;
+        if (!intersect_analytic(*geometry, args->primID, context->rays[id], limit, hit)) continue;
+        context->best_t[id] = hit.t;
+        // Round the float distance up so Embree keeps visiting boxes that may hold a closer hit.
+        RTCRayN_tfar(rays, args->N, i) = std::nextafter(float(hit.t), INFINITY);
+        RTCHitN_geomID(hits, args->N, i) = args->geomID;
+        RTCHitN_primID(hits, args->N, i) = args->primID;
+        RTCHitN_instID(hits, args->N, i, 0) = RTC_INVALID_GEOMETRY_ID;
+        RTCHitN_u(hits, args->N, i) = 0;
+        RTCHitN_v(hits, args->N, i) = 0;
+        RTCHitN_Ng_x(hits, args->N, i) = float(hit.normal.x);
+        RTCHitN_Ng_y(hits, args->N, i) = float(hit.normal.y);
+        RTCHitN_Ng_z(hits, args->N, i) = float(hit.normal.z);
+    }
 }
 
 void analytic_occluded(const RTCOccludedFunctionNArguments* args) {
-    if (args->N != 1 || !args->valid[0]) return;
     const auto* geometry = static_cast<const AnalyticGeometry*>(args->geometryUserPtr);
     const auto* context = reinterpret_cast<const QueryContext*>(args->context);
-    auto* ray = reinterpret_cast<RTCRay*>(args->ray);
-    ShapeHit hit;
-    if (intersect_analytic(*geometry, args->primID, *context->ray, context->ray->t_max, hit))
-        ray->tfar = -INFINITY;  // Embree's mark for "occluded"
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (!args->valid[i]) continue;
+        const Ray& ray = context->rays[RTCRayN_id(args->ray, args->N, i)];
+        ShapeHit hit;
+        if (intersect_analytic(*geometry, args->primID, ray, ray.t_max, hit))
+            RTCRayN_tfar(args->ray, args->N, i) = -INFINITY;  // Embree's mark for "occluded"
+    }
 }
 
 /// Embree calls this from C code, where an exception must not pass: keep the first message
@@ -93,7 +101,7 @@ void record_embree_error(void* user, RTCError code, const char* message) {
                            : std::string("Embree: ") + (message ? message : "unknown error");
 }
 
-RTCRay make_embree_ray(const Ray& ray) {
+RTCRay make_embree_ray(const Ray& ray, unsigned id) {
     RTCRay r;
     r.org_x = float(ray.origin.x);
     r.org_y = float(ray.origin.y);
@@ -105,7 +113,7 @@ RTCRay make_embree_ray(const Ray& ray) {
     r.tfar = float(ray.t_max);
     r.time = 0;
     r.mask = 0xFFFFFFFFu;
-    r.id = 0;
+    r.id = id;
     r.flags = 0;
     return r;
 }
@@ -209,41 +217,32 @@ struct Accelerator::Impl {
         return len > 0 ? blended / len : normalize(hit.normal);
     }
 
-    bool intersect(const Ray& ray, SurfaceHit& out) const {
-        QueryContext context;
-        rtcInitIntersectContext(&context.embree);
-        context.ray = &ray;
-        context.best_t = ray.t_max;
-        RTCRayHit rayhit;
-        rayhit.ray = make_embree_ray(ray);
-        rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(rtc_scene, &context.embree, &rayhit);
-
+    /// The exact hit for what Embree found on one ray (geom == invalid: nothing), then the planes.
+    bool finish_hit(const Ray& ray, unsigned geom, unsigned prim, float u, float v, float t, const Vec3& embree_normal,
+                    double best_t, SurfaceHit& out) const {
         bool found = false;
         double t_max = ray.t_max;
         ShapeHit hit;
-        if (rayhit.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
-            const unsigned geom = rayhit.hit.geomID, prim = rayhit.hit.primID;
+        if (geom != RTC_INVALID_GEOMETRY_ID) {
             if (kinds[geom] == ShapeKind::triangles) {
                 const TriangleMesh& mesh = scene.meshes[mesh_of_geometry[geom]];
                 const uint32_t* index = &mesh.indices[3 * size_t(prim)];
                 if (!intersect_triangle(vertex(mesh, index[0]), vertex(mesh, index[1]), vertex(mesh, index[2]), ray,
                                         ray.t_min, ray.t_max, hit)) {
                     // Float and double disagree on an edge: keep Embree's answer.
-                    hit.t = rayhit.ray.tfar;
-                    hit.u = rayhit.hit.u;
-                    hit.v = rayhit.hit.v;
-                    hit.normal = {rayhit.hit.Ng_x, rayhit.hit.Ng_y, rayhit.hit.Ng_z};
+                    hit.t = t;
+                    hit.u = u;
+                    hit.v = v;
+                    hit.normal = embree_normal;
                 }
                 out.normal = triangle_normal(mesh, prim, hit);
                 out.material = mesh.triangle_materials.empty() ? mesh.material : mesh.triangle_materials[prim];
             } else {
                 const AnalyticGeometry& geometry = kinds[geom] == ShapeKind::spheres ? spheres : boxes;
                 // The callback kept the exact distance; recompute up to it to get that hit's normal.
-                if (!intersect_analytic(geometry, prim, ray, std::nextafter(context.best_t, INFINITY), hit)) {
-                    hit.t = context.best_t;
-                    hit.normal = {rayhit.hit.Ng_x, rayhit.hit.Ng_y, rayhit.hit.Ng_z};
+                if (!intersect_analytic(geometry, prim, ray, std::nextafter(best_t, INFINITY), hit)) {
+                    hit.t = best_t;
+                    hit.normal = embree_normal;
                 }
                 out.normal = normalize(hit.normal);
                 out.material =
@@ -267,18 +266,103 @@ struct Accelerator::Impl {
         return found;
     }
 
-    bool occluded(const Ray& ray) const {
+    bool intersect(const Ray& ray, SurfaceHit& out) const {
+        QueryContext context;
+        rtcInitIntersectContext(&context.embree);
+        context.rays = &ray;
+        context.best_t[0] = ray.t_max;
+        RTCRayHit rayhit;
+        rayhit.ray = make_embree_ray(ray, 0);
+        rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(rtc_scene, &context.embree, &rayhit);
+        return finish_hit(ray, rayhit.hit.geomID, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v, rayhit.ray.tfar,
+                          {rayhit.hit.Ng_x, rayhit.hit.Ng_y, rayhit.hit.Ng_z}, context.best_t[0], out);
+    }
+
+    void intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found) const {
+        QueryContext context;
+        rtcInitIntersectContext(&context.embree);
+        context.embree.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        context.rays = rays;
+        alignas(64) int valid[packet_size];
+        alignas(64) RTCRayHit16 packet;
+        for (int i = 0; i < packet_size; ++i) {
+            valid[i] = (i < count && active[i]) ? -1 : 0;
+            const Ray& ray = rays[i < count ? i : 0];
+            context.best_t[i] = ray.t_max;
+            packet.ray.org_x[i] = float(ray.origin.x);
+            packet.ray.org_y[i] = float(ray.origin.y);
+            packet.ray.org_z[i] = float(ray.origin.z);
+            packet.ray.dir_x[i] = float(ray.direction.x);
+            packet.ray.dir_y[i] = float(ray.direction.y);
+            packet.ray.dir_z[i] = float(ray.direction.z);
+            packet.ray.tnear[i] = float(ray.t_min);
+            packet.ray.tfar[i] = float(ray.t_max);
+            packet.ray.time[i] = 0;
+            packet.ray.mask[i] = 0xFFFFFFFFu;
+            packet.ray.id[i] = unsigned(i);
+            packet.ray.flags[i] = 0;
+            packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+            packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect16(valid, rtc_scene, &context.embree, &packet);
+        for (int i = 0; i < count; ++i) {
+            if (!active[i]) continue;
+            found[i] = finish_hit(rays[i], packet.hit.geomID[i], packet.hit.primID[i], packet.hit.u[i], packet.hit.v[i],
+                                  packet.ray.tfar[i], {packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i]},
+                                  context.best_t[i], hits[i]);
+        }
+    }
+
+    bool occluded_by_plane(const Ray& ray) const {
         for (const Plane& plane : scene.planes) {
             ShapeHit hit;
             if (intersect_plane(plane, ray, ray.t_min, ray.t_max, hit)) return true;
         }
+        return false;
+    }
+
+    bool occluded(const Ray& ray) const {
+        if (occluded_by_plane(ray)) return true;
         QueryContext context;
         rtcInitIntersectContext(&context.embree);
-        context.ray = &ray;
-        context.best_t = ray.t_max;
-        RTCRay r = make_embree_ray(ray);
+        context.rays = &ray;
+        RTCRay r = make_embree_ray(ray, 0);
         rtcOccluded1(rtc_scene, &context.embree, &r);
         return r.tfar < 0;
+    }
+
+    void occluded_packet(const Ray* rays, const bool* active, int count, bool* blocked) const {
+        QueryContext context;
+        rtcInitIntersectContext(&context.embree);
+        context.embree.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        context.rays = rays;
+        alignas(64) int valid[packet_size];
+        alignas(64) RTCRay16 packet;
+        int remaining = 0;
+        for (int i = 0; i < packet_size; ++i) {
+            const bool query = i < count && active[i] && !(blocked[i] = occluded_by_plane(rays[i]));
+            valid[i] = query ? -1 : 0;
+            remaining += query;
+            const Ray& ray = rays[i < count ? i : 0];
+            packet.org_x[i] = float(ray.origin.x);
+            packet.org_y[i] = float(ray.origin.y);
+            packet.org_z[i] = float(ray.origin.z);
+            packet.dir_x[i] = float(ray.direction.x);
+            packet.dir_y[i] = float(ray.direction.y);
+            packet.dir_z[i] = float(ray.direction.z);
+            packet.tnear[i] = float(ray.t_min);
+            packet.tfar[i] = float(ray.t_max);
+            packet.time[i] = 0;
+            packet.mask[i] = 0xFFFFFFFFu;
+            packet.id[i] = unsigned(i);
+            packet.flags[i] = 0;
+        }
+        if (remaining == 0) return;
+        rtcOccluded16(valid, rtc_scene, &context.embree, &packet);
+        for (int i = 0; i < count; ++i)
+            if (valid[i]) blocked[i] = packet.tfar[i] < 0;
     }
 };
 
@@ -289,6 +373,14 @@ bool Accelerator::intersect(const Ray& ray, SurfaceHit& hit) const {
 }
 bool Accelerator::occluded(const Ray& ray) const {
     return m_impl->occluded(ray);
+}
+
+void Accelerator::intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits,
+                                   bool* found) const {
+    m_impl->intersect_packet(rays, active, count, hits, found);
+}
+void Accelerator::occluded_packet(const Ray* rays, const bool* active, int count, bool* blocked) const {
+    m_impl->occluded_packet(rays, active, count, blocked);
 }
 
 }  // namespace whitted

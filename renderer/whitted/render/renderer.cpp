@@ -17,17 +17,60 @@ namespace whitted {
 
 Color render_pixel(const Scene& scene, const LectureShading& shading, int i, int j, RayCounts& counts) {
     const int n = scene.samples;
+    Ray rays[Accelerator::packet_size];
+    Color radiance[Accelerator::packet_size];
     Color sum(0.0);
+    int count = 0;
     for (int b = 0; b < n; ++b) {
         for (int a = 0; a < n; ++a) {
             double x0, y0;
             sample_position(i, j, a, b, n, scene.width, scene.height, x0, y0);
-            ++counts.camera;
-            sum += shading.trace(camera_ray(scene.camera, x0, y0), 0, counts);
+            rays[count++] = camera_ray(scene.camera, x0, y0);
+            if (count == Accelerator::packet_size || (a == n - 1 && b == n - 1)) {
+                shading.trace_packet(rays, count, 0, radiance, counts);
+                for (int k = 0; k < count; ++k) sum += radiance[k];
+                counts.camera += count;
+                count = 0;
+            }
         }
     }
     return n == 1 ? sum : sum / double(n * n);
 }
+
+namespace {
+
+/// The pixels of [x_begin, x_end) × [y_begin, y_end) with one sample each, traced as packets of
+/// 4×4 neighbouring pixels; the same values render_pixel gives one by one.
+void render_block_single_sample(const Scene& scene, const LectureShading& shading, int x_begin, int x_end, int y_begin,
+                                int y_end, Image& image, RayCounts& counts) {
+    constexpr int side = 4;
+    static_assert(side * side == Accelerator::packet_size);
+    for (int by = y_begin; by < y_end; by += side) {
+        for (int bx = x_begin; bx < x_end; bx += side) {
+            Ray rays[Accelerator::packet_size];
+            Color radiance[Accelerator::packet_size];
+            int pixel_x[Accelerator::packet_size], pixel_y[Accelerator::packet_size];
+            int count = 0;
+            for (int y = by; y < std::min(by + side, y_end); ++y) {
+                for (int x = bx; x < std::min(bx + side, x_end); ++x) {
+                    double x0, y0;
+                    sample_position(x, y, 0, 0, 1, scene.width, scene.height, x0, y0);
+                    rays[count] = camera_ray(scene.camera, x0, y0);
+                    pixel_x[count] = x, pixel_y[count] = y;
+                    ++count;
+                }
+            }
+            shading.trace_packet(rays, count, 0, radiance, counts);
+            counts.camera += count;
+            for (int k = 0; k < count; ++k) {
+                float* out = &image.rgb[3 * (size_t(pixel_y[k]) * scene.width + pixel_x[k])];
+                out[0] = float(radiance[k].x), out[1] = float(radiance[k].y), out[2] = float(radiance[k].z);
+            }
+        }
+    }
+}
+
+}  // namespace
 
 RenderResult render(const Scene& scene, const Accelerator& accelerator, const RenderOptions& options) {
     using clock = std::chrono::steady_clock;
@@ -72,11 +115,15 @@ RenderResult render(const Scene& scene, const Accelerator& accelerator, const Re
                 const int x_begin = int(t % tiles_x) * tile, y_begin = int(t / tiles_x) * tile;
                 const int x_end = std::min(x_begin + tile, scene.width), y_end = std::min(y_begin + tile, scene.height);
                 RayCounts counts;
-                for (int y = y_begin; y < y_end; ++y) {
-                    for (int x = x_begin; x < x_end; ++x) {
-                        const Color c = render_pixel(scene, shading, x, y, counts);
-                        float* out = &result.image.rgb[3 * (size_t(y) * scene.width + x)];
-                        out[0] = float(c.x), out[1] = float(c.y), out[2] = float(c.z);
+                if (scene.samples == 1) {
+                    render_block_single_sample(scene, shading, x_begin, x_end, y_begin, y_end, result.image, counts);
+                } else {
+                    for (int y = y_begin; y < y_end; ++y) {
+                        for (int x = x_begin; x < x_end; ++x) {
+                            const Color c = render_pixel(scene, shading, x, y, counts);
+                            float* out = &result.image.rgb[3 * (size_t(y) * scene.width + x)];
+                            out[0] = float(c.x), out[1] = float(c.y), out[2] = float(c.z);
+                        }
                     }
                 }
                 camera_rays += counts.camera;

@@ -5,13 +5,14 @@
 
 namespace whitted {
 
+namespace {
+constexpr int packet_size = Accelerator::packet_size;
+}
+
 Color LectureShading::trace(const Ray& ray, int hits_so_far, RayCounts& counts) const {
-    // Past the last allowed surface hit a ray contributes black, not the background
-    // (POV-Ray's max_trace_level semantics, scene-format v1 `render.max_depth`).
-    if (hits_so_far >= m_scene.max_depth) return Color(0.0);
-    SurfaceHit hit;
-    if (!m_accelerator.intersect(ray, hit)) return m_scene.background;
-    return shade(ray, hit, hits_so_far, counts);
+    Color radiance;
+    trace_packet(&ray, 1, hits_so_far, &radiance, counts);
+    return radiance;
 }
 
 double LectureShading::specular_lobe(const Material& material, const Vec3& normal, const Vec3& to_eye,
@@ -31,50 +32,100 @@ double LectureShading::specular_lobe(const Material& material, const Vec3& norma
     return r_dot_l > 0 ? std::pow(r_dot_l, material.p) : 0.0;
 }
 
-bool LectureShading::shadow_ray_blocked(const Vec3& point, const Vec3& to_light, double light_distance,
-                                        RayCounts& counts) const {
-    ++counts.shadow;
-    const Ray shadow_ray{point, to_light, ray_limits::shadow_epsilon, light_distance - ray_limits::shadow_epsilon};
-    if (!(shadow_ray.t_max > shadow_ray.t_min)) return false;  // the light is (almost) on the surface
-    return m_accelerator.occluded(shadow_ray);
+void LectureShading::direct_lighting(const SurfaceHit* hits, const Ray* rays, const bool* active, int count,
+                                     Color* local, RayCounts& counts) const {
+    Vec3 normal[packet_size];
+    for (int i = 0; i < count; ++i) {
+        if (!active[i]) continue;
+        normal[i] = facing_normal(hits[i], rays[i]);
+        local[i] = m_scene.materials[hits[i].material].ka * m_scene.ambient;  // ambient: ka·Ia
+    }
+    for (const Light& light : m_scene.lights) {
+        Ray shadow_rays[packet_size];
+        bool query[packet_size] = {}, blocked[packet_size] = {}, lit[packet_size] = {};
+        double n_dot_l[packet_size];
+        for (int i = 0; i < count; ++i) {
+            if (!active[i]) continue;
+            const Vec3& point = hits[i].point;
+            Vec3 to_light;  // l
+            double light_distance;
+            if (light.type == LightType::point) {
+                const Vec3 offset = light.position - point;
+                light_distance = length(offset);
+                if (!(light_distance > 0)) continue;
+                to_light = offset / light_distance;
+            } else {
+                to_light = light.toward_light;
+                light_distance = ray_limits::directional_light_distance - dot(point, to_light);
+            }
+            n_dot_l[i] = dot(normal[i], to_light);
+            // The gate on both terms: a light behind the surface adds nothing.
+            if (!(n_dot_l[i] > ray_limits::cosine_epsilon)) continue;
+            lit[i] = true;
+            // Shadow ray from x itself (no offset; the epsilons do the work) to just short of the light.
+            shadow_rays[i] = {point, to_light, ray_limits::shadow_epsilon, light_distance - ray_limits::shadow_epsilon};
+            query[i] = shadow_rays[i].t_max > shadow_rays[i].t_min;  // else the light is on the surface: unblocked
+            counts.shadow += query[i];
+        }
+        m_accelerator.occluded_packet(shadow_rays, query, count, blocked);
+        for (int i = 0; i < count; ++i) {
+            if (!lit[i] || (query[i] && blocked[i])) continue;  // a blocked light adds neither term
+            const Material& material = m_scene.materials[hits[i].material];
+            const Vec3& to_light = shadow_rays[i].direction;
+            const Color diffuse = material.kd * light.intensity * n_dot_l[i];
+            const Color specular =
+                material.ks * light.intensity * specular_lobe(material, normal[i], -rays[i].direction, to_light);
+            local[i] += diffuse + specular;
+        }
+    }
 }
 
-Color LectureShading::shade(const Ray& ray, const SurfaceHit& hit, int hits_so_far, RayCounts& counts) const {
-    const Material& material = m_scene.materials[hit.material];
-    // Two-sided surfaces: turn n toward where the ray came from.
-    const Vec3 normal = dot(hit.normal, ray.direction) > 0 ? -hit.normal : hit.normal;
-    const Vec3 to_eye = -ray.direction;  // v
-
-    Color radiance = material.ka * m_scene.ambient;  // ambient: ka·Ia
-    for (const Light& light : m_scene.lights) {
-        Vec3 to_light;  // l
-        double light_distance;
-        if (light.type == LightType::point) {
-            const Vec3 offset = light.position - hit.point;
-            light_distance = length(offset);
-            if (!(light_distance > 0)) continue;
-            to_light = offset / light_distance;
-        } else {
-            to_light = light.toward_light;
-            light_distance = ray_limits::directional_light_distance - dot(hit.point, to_light);
+void LectureShading::trace_packet(const Ray* first_rays, int count, int hits_so_far, Color* radiance,
+                                  RayCounts& counts) const {
+    Ray rays[packet_size];
+    Color weight[packet_size];  // product of the mirror coefficients along the path so far
+    bool active[packet_size] = {};
+    for (int i = 0; i < count; ++i) {
+        rays[i] = first_rays[i];
+        weight[i] = Color(1.0);
+        radiance[i] = Color(0.0);
+        active[i] = true;
+    }
+    // A path segment past the last allowed surface hit contributes black, not the background
+    // (POV-Ray's max_trace_level semantics, scene-format v1 `render.max_depth`).
+    for (int level = hits_so_far; level < m_scene.max_depth; ++level) {
+        SurfaceHit hits[packet_size];
+        bool found[packet_size] = {};
+        m_accelerator.intersect_packet(rays, active, count, hits, found);
+        bool any_hit = false;
+        for (int i = 0; i < count; ++i) {
+            if (active[i] && !found[i]) {
+                radiance[i] += weight[i] * m_scene.background;  // a miss sees the background
+                active[i] = false;
+            }
+            any_hit |= active[i];
         }
-        const double n_dot_l = dot(normal, to_light);
-        // The gate on both terms: a light behind the surface, or blocked, adds nothing.
-        if (!(n_dot_l > ray_limits::cosine_epsilon)) continue;
-        if (shadow_ray_blocked(hit.point, to_light, light_distance, counts)) continue;
-        const Color diffuse = material.kd * light.intensity * n_dot_l;
-        const Color specular = material.ks * light.intensity * specular_lobe(material, normal, to_eye, to_light);
-        radiance += diffuse + specular;
-    }
+        if (!any_hit) break;
 
-    if (!is_zero(material.km) && hits_so_far + 1 < m_scene.max_depth) {
-        // Mirror: r = 2(n·v)n − v, from the hit point itself (no offset; t_min does the work).
-        const Vec3 mirror_direction = normalize(normal * (2.0 * dot(normal, to_eye)) - to_eye);
-        const Ray reflected{hit.point, mirror_direction, ray_limits::surface_t_min, ray_limits::max_distance};
-        ++counts.reflected;
-        radiance += material.km * trace(reflected, hits_so_far + 1, counts);
+        Color local[packet_size];
+        direct_lighting(hits, rays, active, count, local, counts);
+        for (int i = 0; i < count; ++i) {
+            if (!active[i]) continue;
+            radiance[i] += weight[i] * local[i];
+            const Material& material = m_scene.materials[hits[i].material];
+            if (is_zero(material.km) || level + 1 >= m_scene.max_depth) {
+                active[i] = false;
+                continue;
+            }
+            // Mirror: r = 2(n·v)n − v, from the hit point itself (no offset; t_min does the work).
+            const Vec3 normal = facing_normal(hits[i], rays[i]);
+            const Vec3 to_eye = -rays[i].direction;
+            const Vec3 mirror_direction = normalize(normal * (2.0 * dot(normal, to_eye)) - to_eye);
+            rays[i] = {hits[i].point, mirror_direction, ray_limits::surface_t_min, ray_limits::max_distance};
+            weight[i] = weight[i] * material.km;
+            ++counts.reflected;
+        }
     }
-    return radiance;
 }
 
 }  // namespace whitted

@@ -21,13 +21,18 @@ struct RayCounts {
     }
 };
 
-/// The lecture's shading model, evaluated recursively (Whitted-style):
+/// The lecture's shading model, evaluated Whitted-style:
 ///
 ///   L = ka·Ia + Σ_i [ kd·I_i·max(0, n·l_i) + ks·I_i·max(0, n·h_i)^p ] + km·L(r)
 ///
 /// with the conventions of scene-format v1 (and POV-Ray 3.7): two-sided normals, a light
 /// counts only where n·l_i > 1e-10 and its shadow ray is clear, and then adds both its diffuse
 /// and its specular term; r = 2(n·v)n − v is traced while the path has surface hits left.
+///
+/// The recursion km·L(r) is unrolled into a loop over path segments with a running weight
+/// (the product of the km met so far), so that up to a packet of neighbouring rays is traced
+/// together at every level: camera rays, then their shadow rays light by light, then their
+/// mirror rays.
 class LectureShading {
 public:
     LectureShading(const Scene& scene, const Accelerator& accelerator) : m_scene(scene), m_accelerator(accelerator) {}
@@ -35,16 +40,25 @@ public:
     /// Radiance along `ray`, which is the `hits_so_far`-th segment of its path (0 = camera ray).
     Color trace(const Ray& ray, int hits_so_far, RayCounts& counts) const;
 
-    /// The colour of one hit: ambient + every unshadowed light + mirror.
-    Color shade(const Ray& ray, const SurfaceHit& hit, int hits_so_far, RayCounts& counts) const;
+    /// Radiance along `count` (≤ Accelerator::packet_size) rays that start their paths here,
+    /// each as trace(rays[i], hits_so_far) would give it.
+    void trace_packet(const Ray* rays, int count, int hits_so_far, Color* radiance, RayCounts& counts) const;
+
+    /// ka·Ia plus the unshadowed lights' diffuse and specular terms at one hit, for up to a
+    /// packet of hits (`active` marks the lanes in use).
+    void direct_lighting(const SurfaceHit* hits, const Ray* rays, const bool* active, int count, Color* local,
+                         RayCounts& counts) const;
 
     /// The specular term's angular factor for one light: max(0, n·h)^p (Blinn-Phong) or
     /// max(0, r_v·l)^p (Phong). Unit vectors in; `to_eye` is v.
     static double specular_lobe(const Material& material, const Vec3& normal, const Vec3& to_eye, const Vec3& to_light);
 
-private:
-    bool shadow_ray_blocked(const Vec3& point, const Vec3& to_light, double light_distance, RayCounts& counts) const;
+    /// n turned toward where the ray came from: surfaces are two-sided.
+    static Vec3 facing_normal(const SurfaceHit& hit, const Ray& ray) {
+        return dot(hit.normal, ray.direction) > 0 ? -hit.normal : hit.normal;
+    }
 
+private:
     const Scene& m_scene;
     const Accelerator& m_accelerator;
 };
