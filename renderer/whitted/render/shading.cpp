@@ -7,7 +7,24 @@ namespace whitted {
 
 namespace {
 constexpr int packet_size = Accelerator::packet_size;
+
+/// x^p. Whole exponents up to 1024, the usual case (p = 10, 50, 200, ...), go by repeated
+/// squaring: a few multiplications, within a few units in the last place of std::pow, against
+/// std::pow's ~40 ns, which was an eighth of a render's time.
+double power(double x, double p) {
+    if (p >= 1 && p <= 1024 && p == std::floor(p)) {
+        unsigned n = unsigned(p);
+        double result = 1, square = x;
+        while (n) {
+            if (n & 1) result *= square;
+            square *= square;
+            n >>= 1;
+        }
+        return result;
+    }
+    return std::pow(x, p);
 }
+}  // namespace
 
 Color LectureShading::trace(const Ray& ray, int hits_so_far, RayCounts& counts) const {
     Color radiance;
@@ -22,14 +39,14 @@ double LectureShading::specular_lobe(const Material& material, const Vec3& norma
         const double half_length = length(half_vector);
         if (!(half_length > 0)) return 0.0;
         const double n_dot_h = dot(half_vector, normal) / half_length;
-        return n_dot_h > 0 ? std::pow(n_dot_h, material.p) : 0.0;
+        return n_dot_h > 0 ? power(n_dot_h, material.p) : 0.0;
     }
     // Classic Phong: the view ray mirrored about n, r_v = 2(n·v)n − v, against l. POV-Ray drops
     // the term for p ≥ 60 when r_v·l ≤ 0.0008; there it is below 0.0008^60 ≈ 1e-186 anyway,
     // so computing it exactly gives the same pixels (docs/validation.md).
     const Vec3 mirrored_view = normal * (2.0 * dot(normal, to_eye)) - to_eye;
     const double r_dot_l = dot(mirrored_view, to_light);
-    return r_dot_l > 0 ? std::pow(r_dot_l, material.p) : 0.0;
+    return r_dot_l > 0 ? power(r_dot_l, material.p) : 0.0;
 }
 
 void LectureShading::direct_lighting(const SurfaceHit* hits, const Ray* rays, const bool* active, int count,
