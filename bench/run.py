@@ -6,7 +6,6 @@ Usage: bench/run.py WHITTED_BINARY OUT_DIR [--runs N] [--threads T] [--scenes a,
 import argparse
 import os
 import re
-import resource
 import shutil
 import statistics
 import subprocess
@@ -17,15 +16,16 @@ from pathlib import Path
 
 
 def timed(cmd, cwd=None, env=None):
-    """Runs cmd, returns (wall seconds, peak RSS of the child in MB, stderr)."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    """Runs cmd, returns (wall seconds, peak resident memory of that process in MB, stderr)."""
     start = time.perf_counter()
-    proc = subprocess.run(cmd, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    stderr = proc.stderr.read()
+    _, status, usage = os.wait4(proc.pid, 0)
     wall = time.perf_counter() - start
-    if proc.returncode != 0:
-        sys.exit(f"bench: {' '.join(map(str, cmd))} failed ({proc.returncode}):\n{proc.stderr[-2000:]}")
-    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    return wall, max(peak, before) / 1024.0, proc.stderr
+    code = os.waitstatus_to_exitcode(status)
+    if code != 0:
+        sys.exit(f"bench: {' '.join(map(str, cmd))} failed ({code}):\n{stderr[-2000:]}")
+    return wall, usage.ru_maxrss / 1024.0, stderr
 
 
 def main():
