@@ -14,11 +14,47 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <string_view>
 #include <unordered_map>
 
 namespace whitted {
 namespace {
+
+/// The common OBJ number ("-0.123456", "12", "1.5e-3"): at most 15 digits and a small exponent,
+/// so mantissa and power of ten are exact doubles and their quotient is correctly rounded; the
+/// float is within an ulp of std::from_chars, which takes everything else. Both renderers get
+/// the float Whitted stores (the converter writes it out), so that ulp cannot cause a mismatch.
+bool parse_plain_decimal(std::string_view t, float& out) {
+    static constexpr double powers_of_ten[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+                                               1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+    const char* p = t.data();
+    const char* const end = p + t.size();
+    bool negative = false;
+    if (p < end && (*p == '-' || *p == '+')) negative = *p++ == '-';
+    uint64_t mantissa = 0;
+    int digits = 0, exponent = 0;
+    for (; p < end && unsigned(*p - '0') < 10; ++p, ++digits) mantissa = mantissa * 10 + unsigned(*p - '0');
+    if (p < end && *p == '.') {
+        for (++p; p < end && unsigned(*p - '0') < 10; ++p, ++digits, --exponent)
+            mantissa = mantissa * 10 + unsigned(*p - '0');
+    }
+    if (digits == 0 || digits > 15) return false;
+    if (p < end && (*p == 'e' || *p == 'E')) {
+        int written = 0;
+        const char* start = p + 1 + (p + 1 < end && p[1] == '+');
+        const auto [stop, error] = std::from_chars(start, end, written);
+        if (error != std::errc() || stop != end || written < -22 || written > 22) return false;
+        exponent += written;
+        p = end;
+    }
+    if (p != end || exponent < -22 || exponent > 22) return false;
+    double value = double(mantissa);
+    value = exponent < 0 ? value / powers_of_ten[-exponent] : value * powers_of_ten[exponent];
+    if (!(std::fabs(value) <= double(std::numeric_limits<float>::max()))) return false;  // let the slow path say why
+    out = float(negative ? -value : value);
+    return true;
+}
 
 /// One line of an OBJ or MTL file, read token by token.
 class LineReader {
@@ -52,6 +88,7 @@ public:
 
     float parse_float(std::string_view t, const char* what) const {
         float value = 0;
+        if (parse_plain_decimal(t, value)) return value;
         const char* begin = t.data() + (t.front() == '+' ? 1 : 0);
         const auto [end, error] = std::from_chars(begin, t.data() + t.size(), value);
         if (error == std::errc::result_out_of_range || (error == std::errc() && !std::isfinite(value)))
@@ -74,14 +111,14 @@ private:
 
 /// Calls `visit(line_reader, keyword)` for every non-empty, non-comment line.
 template <class Visit>
-void for_each_statement(const std::string& path, const std::string& text, Visit visit) {
+void for_each_statement(const std::string& path, std::string_view text, Visit visit) {
     int line_number = 0;
     size_t begin = 0;
     while (begin < text.size()) {
         size_t end = text.find('\n', begin);
         if (end == std::string::npos) end = text.size();
         ++line_number;
-        LineReader line(path, std::string_view(text).substr(begin, end - begin), line_number);
+        LineReader line(path, text.substr(begin, end - begin), line_number);
         const std::string_view keyword = line.token();
         if (!keyword.empty() && keyword.front() != '#') visit(line, keyword);
         begin = end + 1;
@@ -147,7 +184,8 @@ MeshData load_obj_mesh(const std::string& path, const SourceLocation& referenced
         throw InputError(referenced_at, "mesh file '" + path + "' not found");
     if (!std::filesystem::is_regular_file(status))
         throw InputError(referenced_at, "mesh file '" + path + "' is not a regular file");
-    const std::string text = read_text_file(path, limits::max_mesh_file_bytes, "mesh file");
+    const MappedTextFile file(path, limits::max_mesh_file_bytes, "mesh file");
+    const std::string_view text = file.text();
     check_text_is_readable(text, path);
     const std::filesystem::path directory = std::filesystem::path(path).parent_path();
 

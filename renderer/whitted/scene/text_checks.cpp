@@ -3,6 +3,11 @@
 
 #include "whitted/scene/source_location.h"
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
@@ -38,7 +43,7 @@ std::string read_text_file(const std::string& path, int64_t max_bytes, const std
     return text;
 }
 
-void check_text_is_readable(const std::string& text, const std::string& path) {
+void check_text_is_readable(std::string_view text, const std::string& path) {
     const auto* bytes = reinterpret_cast<const unsigned char*>(text.data());
     const size_t n = text.size();
     // Fast path: 8 bytes at a time while they are all ASCII and none is NUL (mesh files are
@@ -81,6 +86,42 @@ void check_text_is_readable(const std::string& text, const std::string& path) {
             column += 1;
         i += extra + 1;
     }
+}
+
+MappedTextFile::MappedTextFile(const std::string& path, int64_t max_bytes, const std::string& what) {
+    std::error_code error;
+    const auto status = std::filesystem::status(path, error);
+    if (error || !std::filesystem::exists(status)) throw InputError({path}, what + " not found");
+    if (std::filesystem::is_directory(status)) throw InputError({path}, what + " is a directory, not a file");
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw InputError({path}, "cannot open the " + what + ": " + std::strerror(errno));
+    struct stat info {};
+    if (::fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) {
+        ::close(fd);
+        throw InputError({path}, what + " is not a regular file");
+    }
+    if (info.st_size > max_bytes) {
+        ::close(fd);
+        throw InputError(
+            {path}, what + " is " + std::to_string(info.st_size) + " bytes; the limit is " + std::to_string(max_bytes));
+    }
+    m_length = size_t(info.st_size);
+    if (m_length > 0) {
+        m_address = ::mmap(nullptr, m_length, PROT_READ, MAP_PRIVATE, fd, 0);
+        if (m_address == MAP_FAILED) {
+            m_address = nullptr;
+            const int mmap_errno = errno;
+            ::close(fd);
+            throw InputError({path}, "cannot read the " + what + ": " + std::strerror(mmap_errno));
+        }
+        ::madvise(m_address, m_length, MADV_SEQUENTIAL | MADV_WILLNEED);
+        m_text = std::string_view(static_cast<const char*>(m_address), m_length);
+    }
+    ::close(fd);
+}
+
+MappedTextFile::~MappedTextFile() {
+    if (m_address) ::munmap(m_address, m_length);
 }
 
 }  // namespace whitted

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace whitted {
@@ -13,7 +14,23 @@ std::string read_text_file(const std::string& path, int64_t max_bytes, const std
 
 /// Refuses text a YAML parser should never see: NUL bytes (binary files) and invalid UTF-8,
 /// reported at the line and column of the first bad byte.
-void check_text_is_readable(const std::string& text, const std::string& path);
+void check_text_is_readable(std::string_view text, const std::string& path);
+
+/// A file mapped into memory, read-only (mesh files are tens of megabytes: no copy, no zeroed
+/// buffer). Throws InputError like read_text_file.
+class MappedTextFile {
+public:
+    MappedTextFile(const std::string& path, int64_t max_bytes, const std::string& what);
+    ~MappedTextFile();
+    MappedTextFile(const MappedTextFile&) = delete;
+    MappedTextFile& operator=(const MappedTextFile&) = delete;
+    std::string_view text() const { return m_text; }
+
+private:
+    std::string_view m_text;
+    void* m_address = nullptr;
+    size_t m_length = 0;
+};
 
 /// " (did you mean 'x'?)" for the closest candidate within a small edit distance, else "".
 std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates);
