@@ -131,7 +131,7 @@ CheckResult run_check(const std::string& scene_path, const CheckOptions& options
     const Scene scene = validate_scene(description);
     Image ours;
     {
-        const Accelerator accelerator(scene);
+        const Accelerator accelerator(scene, options.threads);
         RenderOptions render_options;
         render_options.threads = options.threads;
         RenderResult rendered = render(scene, accelerator, render_options);

@@ -21,6 +21,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <thread>
 
@@ -162,7 +163,7 @@ int run_render(const RenderArguments& args) {
     }
 
     try {
-        const Accelerator accelerator(scene);
+        const Accelerator accelerator(scene, args.threads);
         const double build_seconds = timer.lap();
         RenderOptions options;
         options.threads = args.threads;
@@ -370,7 +371,14 @@ int main(int argc, char** argv) {
         return code == 0 ? 0 : exit_bad_input;
     }
 
-    if (*render_cmd) return run_render(render_args);
+    if (*render_cmd) {
+        const int code = run_render(render_args);
+        // The image is on disk and the summary printed: skip tearing down the BVH, the image
+        // buffers and the thread pools, which took up to 30 ms of a 0.15 s render. Nothing is
+        // left to flush but stdio.
+        std::fflush(nullptr);
+        std::_Exit(code);
+    }
     if (*convert_cmd) return run_convert(convert_scene, convert_output);
     if (*compare_cmd)
         return run_compare_command(compare_first, compare_second, compare_tolerance / 65535.0, compare_clip,

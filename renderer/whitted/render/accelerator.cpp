@@ -5,10 +5,12 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 namespace whitted {
 namespace {
@@ -141,9 +143,12 @@ struct Accelerator::Impl {
     AnalyticGeometry spheres{ShapeKind::spheres, nullptr};
     AnalyticGeometry boxes{ShapeKind::boxes, nullptr};
 
-    explicit Impl(const Scene& s) : scene(s) {
+    Impl(const Scene& s, int threads) : scene(s) {
         spheres.scene = boxes.scene = &scene;
-        device = rtcNewDevice("verbose=0");
+        // An explicit thread count (the render's): left to itself, Embree's BVH build for 1M
+        // triangles took 0.13-0.27 s from run to run; with the count given, 0.13-0.15 s.
+        const std::string config = "verbose=0,threads=" + std::to_string(threads);
+        device = rtcNewDevice(config.c_str());
         if (!device) throw std::runtime_error("cannot create the Embree device");
         rtcSetDeviceErrorFunction(device, record_embree_error, &embree_error);
         rtc_scene = rtcNewScene(device);
@@ -366,7 +371,9 @@ struct Accelerator::Impl {
     }
 };
 
-Accelerator::Accelerator(const Scene& scene) : m_impl(std::make_unique<Impl>(scene)) {}
+Accelerator::Accelerator(const Scene& scene, int threads)
+    : m_impl(std::make_unique<Impl>(scene,
+                                    threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency())))) {}
 Accelerator::~Accelerator() = default;
 bool Accelerator::intersect(const Ray& ray, SurfaceHit& hit) const {
     return m_impl->intersect(ray, hit);

@@ -21,7 +21,8 @@ struct SurfaceHit {
 /// that wins is recomputed in double from the double ray, so shading sees POV-Ray's precision.
 class Accelerator {
 public:
-    explicit Accelerator(const Scene& scene);
+    /// `threads`: how many threads Embree may use to build (0 = all cores); pass the render's.
+    explicit Accelerator(const Scene& scene, int threads = 0);
     ~Accelerator();
     Accelerator(const Accelerator&) = delete;
     Accelerator& operator=(const Accelerator&) = delete;

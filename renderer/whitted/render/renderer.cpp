@@ -75,7 +75,7 @@ void render_block_single_sample(const Scene& scene, const LectureShading& shadin
 RenderResult render(const Scene& scene, const Accelerator& accelerator, const RenderOptions& options) {
     using clock = std::chrono::steady_clock;
     const auto start = clock::now();
-    constexpr int tile = 16;
+    constexpr int tile = 32;
     const int tiles_x = (scene.width + tile - 1) / tile, tiles_y = (scene.height + tile - 1) / tile;
     const size_t tile_count = size_t(tiles_x) * tiles_y;
 
