@@ -101,7 +101,7 @@ void write_exr(const Image& image, const std::string& temp_path, bool half, Imf:
                const std::vector<std::pair<std::string, std::string>>& metadata) {
     // OpenEXR directly (not through OpenImageIO) keeps EXR renders free of OpenImageIO's
     // start-up cost; ZIP blocks are compressed on all cores.
-    Imf::setGlobalThreadCount(int(std::thread::hardware_concurrency()));
+    Imf::setGlobalThreadCount(compression == Imf::NO_COMPRESSION ? 0 : int(std::thread::hardware_concurrency()));
     Imf::Header header(image.width, image.height);
     // Uncompressed by default: deflate (zip) on a 1280x960 float image took 0.3-0.4 s, as long as
     // rendering it, to save about a third of the bytes (docs/performance.md). --exr-compression

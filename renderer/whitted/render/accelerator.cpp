@@ -24,6 +24,7 @@ struct QueryContext {
     RTCIntersectContext embree;
     const Ray* rays = nullptr;
     double best_t[Accelerator::packet_size] = {};  ///< nearest analytic hit so far per ray (double)
+    Vec3 best_normal[Accelerator::packet_size];    ///< and its normal, so it is not computed twice
 };
 
 struct AnalyticGeometry {
@@ -68,6 +69,7 @@ void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
         ShapeHit hit;
         if (!intersect_analytic(*geometry, args->primID, context->rays[id], limit, hit)) continue;
         context->best_t[id] = hit.t;
+        context->best_normal[id] = hit.normal;
         // Round the float distance up so Embree keeps visiting boxes that may hold a closer hit.
         RTCRayN_tfar(rays, args->N, i) = std::nextafter(float(hit.t), INFINITY);
         RTCHitN_geomID(hits, args->N, i) = args->geomID;
@@ -224,7 +226,7 @@ struct Accelerator::Impl {
 
     /// The exact hit for what Embree found on one ray (geom == invalid: nothing), then the planes.
     bool finish_hit(const Ray& ray, unsigned geom, unsigned prim, float u, float v, float t, const Vec3& embree_normal,
-                    double best_t, SurfaceHit& out) const {
+                    double best_t, const Vec3& best_normal, SurfaceHit& out) const {
         bool found = false;
         double t_max = ray.t_max;
         ShapeHit hit;
@@ -243,15 +245,11 @@ struct Accelerator::Impl {
                 out.normal = triangle_normal(mesh, prim, hit);
                 out.material = mesh.triangle_materials.empty() ? mesh.material : mesh.triangle_materials[prim];
             } else {
-                const AnalyticGeometry& geometry = kinds[geom] == ShapeKind::spheres ? spheres : boxes;
-                // The callback kept the exact distance; recompute up to it to get that hit's normal.
-                if (!intersect_analytic(geometry, prim, ray, std::nextafter(best_t, INFINITY), hit)) {
-                    hit.t = best_t;
-                    hit.normal = embree_normal;
-                }
-                out.normal = normalize(hit.normal);
+                // The callback computed this hit in double and kept it.
+                hit.t = best_t;
+                out.normal = normalize(best_normal);
                 out.material =
-                    geometry.kind == ShapeKind::spheres ? scene.spheres[prim].material : scene.boxes[prim].material;
+                    kinds[geom] == ShapeKind::spheres ? scene.spheres[prim].material : scene.boxes[prim].material;
             }
             out.t = hit.t;
             t_max = hit.t;
@@ -282,7 +280,8 @@ struct Accelerator::Impl {
         rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(rtc_scene, &context.embree, &rayhit);
         return finish_hit(ray, rayhit.hit.geomID, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v, rayhit.ray.tfar,
-                          {rayhit.hit.Ng_x, rayhit.hit.Ng_y, rayhit.hit.Ng_z}, context.best_t[0], out);
+                          {rayhit.hit.Ng_x, rayhit.hit.Ng_y, rayhit.hit.Ng_z}, context.best_t[0],
+                          context.best_normal[0], out);
     }
 
     void intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found) const {
@@ -316,7 +315,7 @@ struct Accelerator::Impl {
             if (!active[i]) continue;
             found[i] = finish_hit(rays[i], packet.hit.geomID[i], packet.hit.primID[i], packet.hit.u[i], packet.hit.v[i],
                                   packet.ray.tfar[i], {packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i]},
-                                  context.best_t[i], hits[i]);
+                                  context.best_t[i], context.best_normal[i], hits[i]);
         }
     }
 
