@@ -80,34 +80,37 @@ Transform Transform::then(const Transform& b) const {
     return r;
 }
 
-Vec3 Transform::apply_point(const Vec3& p) const {
-    const Rows& m = m_forward;
+namespace {
+
+Vec3 multiply_point(const Rows& m, const Vec3& p) {
     return {m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
             m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]};
 }
 
-Vec3 Transform::apply_vector(const Vec3& v) const {
-    const Rows& m = m_forward;
+Vec3 multiply_vector(const Rows& m, const Vec3& v) {
     return {m[0] * v.x + m[1] * v.y + m[2] * v.z, m[4] * v.x + m[5] * v.y + m[6] * v.z,
             m[8] * v.x + m[9] * v.y + m[10] * v.z};
+}
+
+}  // namespace
+
+Vec3 Transform::apply_point(const Vec3& p) const {
+    return multiply_point(m_forward, p);
+}
+Vec3 Transform::apply_vector(const Vec3& v) const {
+    return multiply_vector(m_forward, v);
+}
+Vec3 Transform::inverse_point(const Vec3& p) const {
+    return multiply_point(m_inverse, p);
+}
+Vec3 Transform::inverse_vector(const Vec3& v) const {
+    return multiply_vector(m_inverse, v);
 }
 
 Vec3 Transform::apply_normal(const Vec3& n) const {
     const Rows& m = m_inverse;  // transpose of the inverse
     return {m[0] * n.x + m[4] * n.y + m[8] * n.z, m[1] * n.x + m[5] * n.y + m[9] * n.z,
             m[2] * n.x + m[6] * n.y + m[10] * n.z};
-}
-
-Vec3 Transform::inverse_point(const Vec3& p) const {
-    const Rows& m = m_inverse;
-    return {m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
-            m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]};
-}
-
-Vec3 Transform::inverse_vector(const Vec3& v) const {
-    const Rows& m = m_inverse;
-    return {m[0] * v.x + m[1] * v.y + m[2] * v.z, m[4] * v.x + m[5] * v.y + m[6] * v.z,
-            m[8] * v.x + m[9] * v.y + m[10] * v.z};
 }
 
 double Transform::determinant() const {

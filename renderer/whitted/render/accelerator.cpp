@@ -122,6 +122,22 @@ RTCRay make_embree_ray(const Ray& ray, unsigned id) {
     return r;
 }
 
+/// Lane i of a 16-wide Embree packet; `id` = i, so callbacks find the double ray again.
+void set_lane(RTCRay16& packet, int i, const Ray& ray) {
+    packet.org_x[i] = float(ray.origin.x);
+    packet.org_y[i] = float(ray.origin.y);
+    packet.org_z[i] = float(ray.origin.z);
+    packet.dir_x[i] = float(ray.direction.x);
+    packet.dir_y[i] = float(ray.direction.y);
+    packet.dir_z[i] = float(ray.direction.z);
+    packet.tnear[i] = float(ray.t_min);
+    packet.tfar[i] = float(ray.t_max);
+    packet.time[i] = 0;
+    packet.mask[i] = 0xFFFFFFFFu;
+    packet.id[i] = unsigned(i);
+    packet.flags[i] = 0;
+}
+
 Vec3 vertex(const TriangleMesh& mesh, uint32_t index) {
     const float* p = &mesh.positions[4 * size_t(index)];
     return {p[0], p[1], p[2]};
@@ -296,18 +312,7 @@ struct Accelerator::Impl {
             valid[i] = (i < count && active[i]) ? -1 : 0;
             const Ray& ray = rays[i < count ? i : 0];
             context.best_t[i] = ray.t_max;
-            packet.ray.org_x[i] = float(ray.origin.x);
-            packet.ray.org_y[i] = float(ray.origin.y);
-            packet.ray.org_z[i] = float(ray.origin.z);
-            packet.ray.dir_x[i] = float(ray.direction.x);
-            packet.ray.dir_y[i] = float(ray.direction.y);
-            packet.ray.dir_z[i] = float(ray.direction.z);
-            packet.ray.tnear[i] = float(ray.t_min);
-            packet.ray.tfar[i] = float(ray.t_max);
-            packet.ray.time[i] = 0;
-            packet.ray.mask[i] = 0xFFFFFFFFu;
-            packet.ray.id[i] = unsigned(i);
-            packet.ray.flags[i] = 0;
+            set_lane(packet.ray, i, ray);
             packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
             packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
         }
@@ -351,18 +356,7 @@ struct Accelerator::Impl {
             valid[i] = query ? -1 : 0;
             remaining += query;
             const Ray& ray = rays[i < count ? i : 0];
-            packet.org_x[i] = float(ray.origin.x);
-            packet.org_y[i] = float(ray.origin.y);
-            packet.org_z[i] = float(ray.origin.z);
-            packet.dir_x[i] = float(ray.direction.x);
-            packet.dir_y[i] = float(ray.direction.y);
-            packet.dir_z[i] = float(ray.direction.z);
-            packet.tnear[i] = float(ray.t_min);
-            packet.tfar[i] = float(ray.t_max);
-            packet.time[i] = 0;
-            packet.mask[i] = 0xFFFFFFFFu;
-            packet.id[i] = unsigned(i);
-            packet.flags[i] = 0;
+            set_lane(packet, i, ray);
         }
         if (remaining == 0) return;
         rtcOccluded16(valid, rtc_scene, &context.embree, &packet);
