@@ -10,11 +10,11 @@
 namespace whitted {
 
 struct OutputOptions {
-    bool half = false;          ///< EXR: half floats instead of full floats
+    bool half = false;                     ///< EXR: half floats instead of full floats
     std::string exr_compression = "none";  ///< EXR: none, zip, zips, piz or rle (all lossless)
-    int bit_depth = 0;          ///< PNG/TIFF: 8 or 16; 0 = the format's default (PNG/JPEG 8, TIFF 16)
-    std::string ocio_config;    ///< empty: $OCIO, else the built-in config
-    std::string display, view;  ///< empty: the config's defaults
+    int bit_depth = 0;                     ///< PNG/TIFF: 8 or 16; 0 = the format's default (PNG/JPEG 8, TIFF 16)
+    std::string ocio_config;               ///< empty: $OCIO, else the built-in config
+    std::string display, view;             ///< empty: the config's defaults
     std::vector<std::pair<std::string, std::string>> metadata;  ///< extra string attributes
 };
 
