@@ -40,7 +40,9 @@ objects:
     material.ks.value = Color(0.5);
     material.p.value = 60;
     material.km.value = Color(0.1);
-    mesh.material = MaterialReference{{}, {}, material};
+    MaterialReference reference;
+    reference.inline_ = material;
+    mesh.material = reference;
     for (int i = 0; i < major; ++i) {
         const double u = 2 * std::numbers::pi * i / major;
         for (int j = 0; j < minor; ++j) {
