@@ -40,20 +40,17 @@ def torus_obj(path: Path, major: int, minor: int, big_r: float = 1.2, small_r: f
     """A torus around the y axis with smooth vertex normals (vn index = v index)."""
     with path.open("w") as f:
         f.write(f"# torus R={big_r} r={small_r}, {major}x{minor} segments, {2 * major * minor} triangles\n")
+        positions, normals = [], []
         for i in range(major):
             u = 2 * math.pi * i / major
             cu, su = math.cos(u), math.sin(u)
             for j in range(minor):
                 v = 2 * math.pi * j / minor
                 cv, sv = math.cos(v), math.sin(v)
-                f.write(f"v {(big_r + small_r * cv) * cu:.6f} {small_r * sv:.6f} {(big_r + small_r * cv) * su:.6f}\n")
-        for i in range(major):
-            u = 2 * math.pi * i / major
-            cu, su = math.cos(u), math.sin(u)
-            for j in range(minor):
-                v = 2 * math.pi * j / minor
-                cv, sv = math.cos(v), math.sin(v)
-                f.write(f"vn {cv * cu:.6f} {sv:.6f} {cv * su:.6f}\n")
+                positions.append(f"v {(big_r + small_r * cv) * cu:.6f} {small_r * sv:.6f} {(big_r + small_r * cv) * su:.6f}\n")
+                normals.append(f"vn {cv * cu:.6f} {sv:.6f} {cv * su:.6f}\n")
+        f.write("".join(positions))
+        f.write("".join(normals))
         faces = []
         for i in range(major):
             i2 = (i + 1) % major

@@ -21,6 +21,12 @@ enum class ShapeKind : uint32_t { triangles, spheres, boxes };
 /// callbacks read them back from the pointer Embree passes them (Embree's ray `id` is the index
 /// into `rays`), so spheres and boxes never see the float copies.
 struct QueryContext {
+    /// `coherent`: the rays are neighbours (a packet), which Embree can traverse together.
+    QueryContext(const Ray* query_rays, bool coherent) : rays(query_rays) {
+        rtcInitIntersectContext(&embree);
+        if (coherent) embree.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    }
+
     RTCIntersectContext embree;
     const Ray* rays = nullptr;
     double best_t[Accelerator::packet_size] = {};  ///< nearest analytic hit so far per ray (double)
@@ -287,9 +293,7 @@ struct Accelerator::Impl {
     }
 
     bool intersect(const Ray& ray, SurfaceHit& out) const {
-        QueryContext context;
-        rtcInitIntersectContext(&context.embree);
-        context.rays = &ray;
+        QueryContext context(&ray, false);
         context.best_t[0] = ray.t_max;
         RTCRayHit rayhit;
         rayhit.ray = make_embree_ray(ray, 0);
@@ -302,10 +306,7 @@ struct Accelerator::Impl {
     }
 
     void intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found) const {
-        QueryContext context;
-        rtcInitIntersectContext(&context.embree);
-        context.embree.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-        context.rays = rays;
+        QueryContext context(rays, true);
         alignas(64) int valid[packet_size];
         alignas(64) RTCRayHit16 packet;
         for (int i = 0; i < packet_size; ++i) {
@@ -335,19 +336,14 @@ struct Accelerator::Impl {
 
     bool occluded(const Ray& ray) const {
         if (occluded_by_plane(ray)) return true;
-        QueryContext context;
-        rtcInitIntersectContext(&context.embree);
-        context.rays = &ray;
+        QueryContext context(&ray, false);
         RTCRay r = make_embree_ray(ray, 0);
         rtcOccluded1(rtc_scene, &context.embree, &r);
         return r.tfar < 0;
     }
 
     void occluded_packet(const Ray* rays, const bool* active, int count, bool* blocked) const {
-        QueryContext context;
-        rtcInitIntersectContext(&context.embree);
-        context.embree.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-        context.rays = rays;
+        QueryContext context(rays, true);
         alignas(64) int valid[packet_size];
         alignas(64) RTCRay16 packet;
         int remaining = 0;
