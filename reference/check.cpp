@@ -79,10 +79,6 @@ bool povray_clipped(const Image& full, const Image& ours, int n, double exposure
     return false;
 }
 
-std::string codes(double value) {
-    return fmt::format("{:.1f}", value * 65535.0);
-}
-
 std::string rgb_text(const float* v) {
     return fmt::format("{:.6f} {:.6f} {:.6f}", v[0], v[1], v[2]);
 }
@@ -99,7 +95,7 @@ void print_table(const std::string& scene_path, const CheckResult& r, const Chec
                     c.height, r.samples * r.samples, r.exposure, r.exposure != 1 ? " (scene values above 1)" : "");
     out += fmt::format("  Whitted {:.3f}s, POV-Ray {:.2f}s ({} run{}, {})\n", r.whitted_seconds, r.povray_seconds,
                        r.povray_runs, r.povray_runs == 1 ? "" : "s", r.povray_program);
-    out += fmt::format("  max error    {:.3e}  ({} codes of 65535)\n", c.max_error, codes(c.max_error));
+    out += fmt::format("  max error    {:.3e}  ({} codes of 65535)\n", c.max_error, format_codes(c.max_error));
     out +=
         fmt::format("  mean error   {:.3e}  ({} codes)\n", c.mean_error, fmt::format("{:.3f}", c.mean_error * 65535));
     out += fmt::format("  RMS error    {:.3e}  ({} codes)\n", c.rms_error, fmt::format("{:.3f}", c.rms_error * 65535));
@@ -120,7 +116,7 @@ void print_table(const std::string& scene_path, const CheckResult& r, const Chec
 
 std::string verdict_line(const std::string& scene_path, const CheckResult& r, const CheckOptions& options) {
     return fmt::format("{} {}: {} of pixels within {:g}/65535 (max {} codes)", r.passed ? "PASS" : "FAIL", scene_path,
-                       format_percent(r.comparison), options.tolerance * 65535, codes(r.comparison.max_error));
+                       format_percent(r.comparison), options.tolerance * 65535, format_codes(r.comparison.max_error));
 }
 
 CheckResult run_check(const std::string& scene_path, const CheckOptions& options) {

@@ -14,6 +14,12 @@
 
 namespace whitted::reference {
 
+std::string format_codes(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f", value * 65535.0);
+    return text;
+}
+
 std::string format_percent(const ImageComparison& c) {
     if (c.pixels_within == c.pixels) return "100.000%";
     char text[32];

@@ -26,6 +26,9 @@ struct ImageComparison {
 /// that a failing share never reads "100.000%".
 std::string format_percent(const ImageComparison& comparison);
 
+/// A linear value in 16-bit codes (× 65535) with one decimal, e.g. "1.5".
+std::string format_codes(double value);
+
 ImageComparison compare_images(const Image& ours, const Image& theirs, double tolerance);
 
 /// Reads any image OpenImageIO can read as linear float RGB (no colour conversion: PNGs that

@@ -139,10 +139,6 @@ nlohmann::json metrics_json(const std::string& scene_path, const CheckResult& r,
     return j;
 }
 
-std::string codes_text(double value) {
-    return fmt::format("{:.1f}", value * 65535.0);
-}
-
 std::string rgb_cells(const float* v) {
     return fmt::format("<td>{:.6f}</td><td>{:.6f}</td><td>{:.6f}</td>", v[0], v[1], v[2]);
 }
@@ -234,7 +230,7 @@ code { font-size: .95em; }
     auto row = [&](const std::string& name, const std::string& value) {
         h += "<tr><th>" + name + "</th><td>" + value + "</td></tr>\n";
     };
-    row("max error", fmt::format("{:.3e} ({} codes)", c.max_error, codes_text(c.max_error)));
+    row("max error", fmt::format("{:.3e} ({} codes)", c.max_error, format_codes(c.max_error)));
     row("mean error", fmt::format("{:.3e} ({:.3f} codes)", c.mean_error, c.mean_error * 65535));
     row("RMS error", fmt::format("{:.3e} ({:.3f} codes)", c.rms_error, c.rms_error * 65535));
     row("PSNR (peak 1)", std::isinf(c.psnr) ? std::string("∞ (identical)") : fmt::format("{:.1f} dB", c.psnr));

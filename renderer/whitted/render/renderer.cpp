@@ -80,11 +80,9 @@ RenderResult render(const Scene& scene, const Accelerator& accelerator, const Re
     const size_t tile_count = size_t(tiles_x) * tiles_y;
 
     RenderResult result;
-    result.tile_size = tile;
     result.image.width = scene.width;
     result.image.height = scene.height;
     result.image.rgb.assign(size_t(scene.width) * scene.height * 3, 0.0f);
-    std::vector<char> done(tile_count, 0);
     std::atomic<size_t> tiles_done{0};
     std::atomic<uint64_t> camera_rays{0}, shadow_rays{0}, reflected_rays{0};
     const LectureShading shading(scene, accelerator);
@@ -129,7 +127,6 @@ RenderResult render(const Scene& scene, const Accelerator& accelerator, const Re
                 camera_rays += counts.camera;
                 shadow_rays += counts.shadow;
                 reflected_rays += counts.reflected;
-                done[t] = 1;
                 ++tiles_done;
             }
         });
@@ -145,7 +142,6 @@ RenderResult render(const Scene& scene, const Accelerator& accelerator, const Re
     }
     result.rays = {camera_rays.load(), shadow_rays.load(), reflected_rays.load()};
     result.seconds = std::chrono::duration<double>(clock::now() - start).count();
-    result.tile_done.assign(done.begin(), done.end());
     result.cancelled = tiles_done.load() != tile_count;
     if (options.on_progress) options.on_progress({tiles_done.load(), tile_count, result.rays.total(), result.seconds});
     return result;

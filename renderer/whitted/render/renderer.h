@@ -37,8 +37,6 @@ struct RenderResult {
     RayCounts rays;
     double seconds = 0;
     bool cancelled = false;
-    std::vector<bool> tile_done;  ///< which tiles were finished (for --partial)
-    int tile_size = 0;
 };
 
 /// Renders the scene in tiles on all (or `threads`) cores. Every pixel depends only on the

@@ -50,8 +50,7 @@ double LectureShading::specular_lobe(const Material& material, const Vec3& norma
 }
 
 void LectureShading::direct_lighting(const SurfaceHit* hits, const Ray* rays, const bool* active, int count,
-                                     Color* local, RayCounts& counts) const {
-    Vec3 normal[packet_size];
+                                     Color* local, Vec3* normal, RayCounts& counts) const {
     for (int i = 0; i < count; ++i) {
         if (!active[i]) continue;
         normal[i] = facing_normal(hits[i], rays[i]);
@@ -125,7 +124,8 @@ void LectureShading::trace_packet(const Ray* first_rays, int count, int hits_so_
         if (!any_hit) break;
 
         Color local[packet_size];
-        direct_lighting(hits, rays, active, count, local, counts);
+        Vec3 normal[packet_size];
+        direct_lighting(hits, rays, active, count, local, normal, counts);
         for (int i = 0; i < count; ++i) {
             if (!active[i]) continue;
             radiance[i] += weight[i] * local[i];
@@ -135,9 +135,8 @@ void LectureShading::trace_packet(const Ray* first_rays, int count, int hits_so_
                 continue;
             }
             // Mirror: r = 2(n·v)n − v, from the hit point itself (no offset; t_min does the work).
-            const Vec3 normal = facing_normal(hits[i], rays[i]);
             const Vec3 to_eye = -rays[i].direction;
-            const Vec3 mirror_direction = normalize(normal * (2.0 * dot(normal, to_eye)) - to_eye);
+            const Vec3 mirror_direction = normalize(normal[i] * (2.0 * dot(normal[i], to_eye)) - to_eye);
             rays[i] = {hits[i].point, mirror_direction, ray_limits::surface_t_min, ray_limits::max_distance};
             weight[i] = weight[i] * material.km;
             ++counts.reflected;

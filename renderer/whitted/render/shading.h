@@ -45,9 +45,10 @@ public:
     void trace_packet(const Ray* rays, int count, int hits_so_far, Color* radiance, RayCounts& counts) const;
 
     /// ka·Ia plus the unshadowed lights' diffuse and specular terms at one hit, for up to a
-    /// packet of hits (`active` marks the lanes in use).
+    /// packet of hits (`active` marks the lanes in use). `normal` receives each hit's
+    /// ray-facing normal, which the mirror ray needs too.
     void direct_lighting(const SurfaceHit* hits, const Ray* rays, const bool* active, int count, Color* local,
-                         RayCounts& counts) const;
+                         Vec3* normal, RayCounts& counts) const;
 
     /// The specular term's angular factor for one light: max(0, n·h)^p (Blinn-Phong) or
     /// max(0, r_v·l)^p (Phong). Unit vectors in; `to_eye` is v.
