@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include <sys/prctl.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -283,6 +284,11 @@ int run_compare_command(const std::string& first, const std::string& second, dou
 }  // namespace
 
 int main(int argc, char** argv) {
+    // Embree asks for transparent huge pages (madvise) for all its BVH memory. Here, faulting
+    // them in made the 1M-triangle build take 0.25-0.3 s in about every other run against
+    // 0.13-0.16 s with ordinary pages, and rendering was no faster with them
+    // (docs/performance.md). This turns them off for the process only.
+    prctl(PR_SET_THP_DISABLE, 1, 0, 0, 0);
     CLI::App app{
         "Whitted: an offline ray tracer for the classic lecture shading model\n"
         "  L = ka*Ia + sum_i [kd*I_i*max(0,n.l_i) + ks*I_i*max(0,n.h_i)^p] + km*L(r)\n"

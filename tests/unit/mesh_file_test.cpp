@@ -10,7 +10,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <set>
+#include <utility>
+#include <vector>
 
 namespace whitted {
 namespace {
@@ -137,6 +140,130 @@ TEST(ObjMesh, OutOfRangeFaceIndexNamesTheFile) {
     const auto error = test::input_error_from([&] { (void)load_obj_mesh(path, {"scene.yaml", 4, 11}); });
     ASSERT_TRUE(error);
     EXPECT_THAT(std::string(error->what()), HasSubstr(path));
+}
+
+// Large files are read by several threads, a run of lines each. Whatever the number of runs,
+// the mesh must be the same, value for value: every statement form the reader takes appears in
+// this file, and with 1..7 runs its lines are cut at many different places.
+std::string every_form_obj() {
+    std::string text = "# every statement form the reader takes\r\n\n   \t\n";
+    text += "o torus\ng group\ns 1\nvt 0.5 0.5\n";
+    for (int i = 0; i < 40; ++i) {
+        const double x = 0.1 * i, y = -0.25 * i + 1e-3, z = 1.0 / (i + 3);
+        char line[160];
+        switch (i % 4) {
+            case 0:
+                std::snprintf(line, sizeof line, "v %.6f %.6f %.6f\n", x, y, z);
+                break;
+            case 1:
+                std::snprintf(line, sizeof line, "v %.17g\t%.17g %.17g 1.0\r\n", x, y, z);
+                break;
+            case 2:
+                std::snprintf(line, sizeof line, "  v %.3e %+.4e %.9E  \n", x, y, z);
+                break;
+            default:
+                std::snprintf(line, sizeof line, "v %g %g %g\n", x, y, z);
+                break;
+        }
+        text += line;
+        std::snprintf(line, sizeof line, "vn %.6f %.6f %.6f\n", z, x, 1.0);
+        text += line;
+    }
+    for (int i = 0; i + 3 < 40; ++i) {
+        const int a = i + 1, b = i + 2, c = i + 3;
+        char line[200];
+        switch (i % 6) {
+            case 0:
+                std::snprintf(line, sizeof line, "f %d %d %d\n", a, b, c);
+                break;
+            case 1:
+                std::snprintf(line, sizeof line, "f %d//%d %d//%d %d//%d\n", a, a, b, b, c, c);
+                break;
+            case 2:
+                std::snprintf(line, sizeof line, "f %d/1/%d %d/1/%d %d/1/%d %d/1/%d\r\n", a, a, b, b, c, c, c + 1,
+                              c + 1);
+                break;
+            case 3:
+                std::snprintf(line, sizeof line, "f -1 -2 -3\n");
+                break;
+            case 4:
+                std::snprintf(line, sizeof line, "\tf %d/1 %d/ %d//\n", a, b, c);
+                break;
+            default:
+                std::snprintf(line, sizeof line, "f %d//%d %d//%d %d//%d\n", a, b, b, c, c, a);
+                break;
+        }
+        text += line;
+    }
+    text += "f";  // a 20-gon, longer than the fast path takes
+    for (int i = 1; i <= 20; ++i) text += " " + std::to_string(i);
+    text += "\nl 1 2\n# no newline at the end\nv 1 2 3";
+    return text;
+}
+
+void expect_same_mesh(const MeshData& a, const MeshData& b, int parts) {
+    EXPECT_EQ(a.positions, b.positions) << parts << " runs";
+    EXPECT_EQ(a.normals, b.normals) << parts << " runs";
+    EXPECT_EQ(a.indices, b.indices) << parts << " runs";
+    EXPECT_EQ(a.triangle_material, b.triangle_material) << parts << " runs";
+}
+
+TEST(ObjMesh, ReadingInRunsGivesTheSameMesh) {
+    const test::ScratchDirectory directory;
+    const std::string path = directory.write("forms.obj", every_form_obj());
+    const MeshData whole = load_obj_mesh(path, {}, 1);
+    ASSERT_EQ(whole.positions.size(), 41u * 3);
+    // Corners name other normals than their positions' (the last f form), so vertices are split.
+    EXPECT_EQ(whole.normals.size(), 0u) << "the v/t and v// corners have no normal: flat";
+    EXPECT_GT(whole.indices.size(), 3u * 37);
+    for (int parts = 2; parts <= 7; ++parts) expect_same_mesh(load_obj_mesh(path, {}, parts), whole, parts);
+}
+
+TEST(ObjMesh, ReadingInRunsKeepsSmoothAndSplitVertices) {
+    // Every corner has a normal, some name another normal than their position's: one vertex per
+    // distinct pair, numbered in order of first use, the same for every number of runs.
+    std::string text;
+    for (int i = 0; i < 30; ++i) text += "v " + std::to_string(i) + " " + std::to_string(i % 7) + " 0.5\n";
+    for (int i = 0; i < 30; ++i) text += "vn 0 " + std::to_string(i % 3) + " 1\n";
+    for (int i = 1; i + 2 <= 30; ++i) {
+        const int n = i % 5 == 0 ? 30 - i : i;  // every fifth face names other normals
+        text += "f " + std::to_string(i) + "//" + std::to_string(n) + " " + std::to_string(i + 1) + "//" +
+                std::to_string(i + 1) + " " + std::to_string(i + 2) + "//" + std::to_string(i + 2) + "\n";
+    }
+    const test::ScratchDirectory directory;
+    const std::string path = directory.write("split.obj", text);
+    const MeshData whole = load_obj_mesh(path, {}, 1);
+    ASSERT_EQ(whole.normals.size(), whole.positions.size());
+    EXPECT_GT(whole.positions.size(), 30u * 3) << "some positions carry two normals";
+    for (int parts = 2; parts <= 6; ++parts) expect_same_mesh(load_obj_mesh(path, {}, parts), whole, parts);
+}
+
+// A mistake anywhere is reported for the same line and column, in the same words, however many
+// runs read the file (an error in a later run must not hide an earlier one).
+TEST(ObjMesh, ReadingInRunsReportsTheFirstMistake) {
+    const std::string good = every_form_obj();
+    const std::vector<std::pair<std::string, std::string>> mistakes = {
+        {"vn 0.", "vn x0."}, {"vn 0.", "vn 1e999 "}, {"f -1 -2 -3\n", "f -1 -2 -90\n"},
+        {"f ", "f 1 2\nf "}, {"//", "///"},          {"o torus\n", "o torus\nv 1 2\n"},
+    };
+    const test::ScratchDirectory directory;
+    for (const auto& [from, to] : mistakes) {
+        for (const bool late : {false, true}) {
+            std::string text = good;
+            const size_t at = late ? text.rfind(from) : text.find(from);
+            ASSERT_NE(at, std::string::npos) << from;
+            text.replace(at, from.size(), to);
+            if (!late) text.replace(text.rfind("f -1 -2 -3\n"), 11, "f 1 2 999\n");  // a second, later mistake
+            const std::string path = directory.write("bad.obj", text);
+            const auto whole = test::input_error_from([&] { (void)load_obj_mesh(path, {}, 1); });
+            ASSERT_TRUE(whole) << to;
+            for (int parts = 2; parts <= 7; ++parts) {
+                const auto in_runs = test::input_error_from([&] { (void)load_obj_mesh(path, {}, parts); });
+                ASSERT_TRUE(in_runs) << to << ", " << parts << " runs";
+                EXPECT_EQ(std::string(in_runs->what()), std::string(whole->what())) << parts << " runs";
+            }
+        }
+    }
 }
 
 // In a scene: the path is relative to the scene file; without `material:` the MTL's materials

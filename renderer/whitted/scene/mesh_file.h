@@ -22,6 +22,8 @@ struct MeshData {
 
 /// Loads an OBJ file (polygons are fanned into triangles). Throws InputError naming the file
 /// (and line where the loader says) for missing files, bad indices and empty meshes.
-MeshData load_obj_mesh(const std::string& path, const SourceLocation& referenced_at);
+/// `parts`: how many runs of lines are read at once (0: one per core for files of several
+/// megabytes); the result, and any error, is the same whatever it is.
+MeshData load_obj_mesh(const std::string& path, const SourceLocation& referenced_at, int parts = 0);
 
 }  // namespace whitted

@@ -43,23 +43,28 @@ std::string read_text_file(const std::string& path, int64_t max_bytes, const std
     return text;
 }
 
-void check_text_is_readable(std::string_view text, const std::string& path) {
+bool is_plain_ascii(std::string_view text) {
     const auto* bytes = reinterpret_cast<const unsigned char*>(text.data());
     const size_t n = text.size();
-    // Fast path: 8 bytes at a time while they are all ASCII and none is NUL (mesh files are
-    // tens of megabytes). Only a chunk with something else in it is looked at byte by byte.
+    // 8 bytes at a time while they are all ASCII and none is NUL (mesh files are tens of
+    // megabytes), then the tail byte by byte.
     size_t clean = 0;
     for (; clean + 8 <= n; clean += 8) {
         uint64_t word;
         std::memcpy(&word, bytes + clean, 8);
         constexpr uint64_t high = 0x8080808080808080ull, ones = 0x0101010101010101ull;
-        if ((word & high) || ((word - ones) & ~word & high)) break;
+        if ((word & high) || ((word - ones) & ~word & high)) return false;
     }
-    if (clean + 8 > n) {
-        size_t i = clean;
-        while (i < n && bytes[i] != 0 && bytes[i] < 0x80) ++i;
-        if (i == n) return;
-    }
+    for (size_t i = clean; i < n; ++i)
+        if (bytes[i] == 0 || bytes[i] >= 0x80) return false;
+    return true;
+}
+
+void check_text_is_readable(std::string_view text, const std::string& path) {
+    // Only text with something other than plain ASCII in it is looked at byte by byte.
+    if (is_plain_ascii(text)) return;
+    const auto* bytes = reinterpret_cast<const unsigned char*>(text.data());
+    const size_t n = text.size();
     int line = 1, column = 1;
     for (size_t i = 0; i < n;) {
         const unsigned char c = bytes[i];

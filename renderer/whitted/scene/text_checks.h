@@ -12,6 +12,9 @@ namespace whitted {
 /// paths with an InputError naming the file (`what` says what the file was meant to be).
 std::string read_text_file(const std::string& path, int64_t max_bytes, const std::string& what);
 
+/// True when every byte is ASCII and none is NUL: such text needs no closer look.
+bool is_plain_ascii(std::string_view text);
+
 /// Refuses text a YAML parser should never see: NUL bytes (binary files) and invalid UTF-8,
 /// reported at the line and column of the first bad byte.
 void check_text_is_readable(std::string_view text, const std::string& path);
