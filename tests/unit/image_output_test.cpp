@@ -1,0 +1,97 @@
+// SPDX-License-Identifier: MIT
+// Writing images: an EXR holds the linear floats exactly, a finished image replaces an existing
+// one, and a failed write leaves the old file as it was and no temporary file behind.
+
+#include "whitted/output/image_output.h"
+
+#include "test_support.h"
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace whitted {
+namespace {
+
+Image ramp(int width, int height, float scale) {
+    Image image;
+    image.width = width;
+    image.height = height;
+    image.rgb.resize(size_t(width) * height * 3);
+    for (size_t i = 0; i < image.rgb.size(); ++i) image.rgb[i] = scale * float(i) / 7.0f;
+    return image;
+}
+
+std::vector<float> read_exr_rgb(const std::string& path) {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i window = file.header().dataWindow();
+    const int width = window.max.x - window.min.x + 1, height = window.max.y - window.min.y + 1;
+    std::vector<float> rgb(size_t(width) * height * 3);
+    Imf::FrameBuffer frame;
+    const char* names[] = {"R", "G", "B"};
+    for (int c = 0; c < 3; ++c)
+        frame.insert(names[c], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(rgb.data() + c), 3 * sizeof(float),
+                                          3 * sizeof(float) * size_t(width)));
+    file.setFrameBuffer(frame);
+    file.readPixels(window.min.y, window.max.y);
+    return rgb;
+}
+
+std::vector<std::string> entries(const std::filesystem::path& directory) {
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(directory))
+        names.push_back(entry.path().filename().string());
+    return names;
+}
+
+std::string bytes_of(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    return bytes.str();
+}
+
+TEST(ImageOutput, ExrHoldsTheLinearFloatsExactly) {
+    const test::ScratchDirectory directory;
+    const std::string path = (directory.path() / "new.exr").string();
+    const Image image = ramp(5, 3, 1.0f);
+    write_image(image, path, {});
+    EXPECT_EQ(read_exr_rgb(path), image.rgb);
+    EXPECT_EQ(entries(directory.path()), std::vector<std::string>{"new.exr"});
+}
+
+// The finished image is swapped in for the old one (renameat2 RENAME_EXCHANGE) and the old one
+// deleted: the path holds the new pixels and nothing else is left in the directory.
+TEST(ImageOutput, FinishedImageReplacesAnExistingOne) {
+    const test::ScratchDirectory directory;
+    const std::string path = (directory.path() / "out.exr").string();
+    write_image(ramp(4, 4, 1.0f), path, {});
+    const Image second = ramp(6, 2, -3.0f);
+    write_image(second, path, {});
+    EXPECT_EQ(read_exr_rgb(path), second.rgb);
+    EXPECT_EQ(entries(directory.path()), std::vector<std::string>{"out.exr"});
+}
+
+TEST(ImageOutput, FailedWriteLeavesTheOldFileAlone) {
+    const test::ScratchDirectory directory;
+    const std::string path = (directory.path() / "keep.exr").string();
+    write_image(ramp(4, 4, 1.0f), path, {});
+    const std::string before = bytes_of(path);
+    OutputOptions bad;
+    bad.exr_compression = "lzma";  // not an EXR compression: refused
+    EXPECT_THROW(write_image(ramp(8, 8, 2.0f), path, bad), std::invalid_argument);
+    EXPECT_EQ(bytes_of(path), before);
+    EXPECT_EQ(entries(directory.path()), std::vector<std::string>{"keep.exr"});
+}
+
+}  // namespace
+}  // namespace whitted
