@@ -20,10 +20,12 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <mutex>
 #include <thread>
 
 namespace {
@@ -54,33 +56,42 @@ extern "C" void on_signal(int signal) {
 /// program: the previous output is untouched and there is no temporary file yet.
 class CancelWatchdog {
 public:
-    CancelWatchdog()
-        : m_thread([this] {
-              while (!m_done.load()) {
-                  if (g_cancel.load()) {
-                      const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(900);
-                      while (!m_done.load() && std::chrono::steady_clock::now() < deadline)
-                          std::this_thread::sleep_for(std::chrono::milliseconds(10));
-                      if (m_done.load()) return;
-                      std::fprintf(stderr,
-                                   "whitted: interrupted; a tile did not finish within a second, "
-                                   "stopped without writing anything\n");
-                      std::fflush(stderr);
-                      ::_exit(128 + g_signal.load());
-                  }
-                  std::this_thread::sleep_for(std::chrono::milliseconds(20));
-              }
-          }) {}
+    CancelWatchdog() : m_thread([this] { watch(); }) {}
     ~CancelWatchdog() {
-        m_done.store(true);
+        {
+            std::lock_guard lock(m_mutex);
+            m_done = true;
+        }
+        m_wake.notify_one();  // at once: a sleeping watchdog cost every render up to 20 ms
         m_thread.join();
     }
     CancelWatchdog(const CancelWatchdog&) = delete;
     CancelWatchdog& operator=(const CancelWatchdog&) = delete;
 
 private:
-    std::atomic<bool> m_done{false};
-    std::thread m_thread;
+    /// True once the render is over; false when `interval` passed first.
+    bool done_within(std::chrono::milliseconds interval) {
+        std::unique_lock lock(m_mutex);
+        return m_wake.wait_for(lock, interval, [this] { return m_done; });
+    }
+
+    void watch() {
+        // A signal handler cannot wake a condition variable, so the signal flag is polled.
+        while (!done_within(std::chrono::milliseconds(20))) {
+            if (!g_cancel.load()) continue;
+            if (done_within(std::chrono::milliseconds(900))) return;
+            std::fprintf(stderr,
+                         "whitted: interrupted; a tile did not finish within a second, "
+                         "stopped without writing anything\n");
+            std::fflush(stderr);
+            ::_exit(128 + g_signal.load());
+        }
+    }
+
+    std::mutex m_mutex;
+    std::condition_variable m_wake;
+    bool m_done = false;
+    std::thread m_thread;  // last: starts once the members it uses exist
 };
 
 void install_signal_handlers() {
