@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "whitted/render/accelerator.h"
 
+#include "whitted/core/packet_array.h"
 #include "whitted/geometry/shapes.h"
 
 #include <embree3/rtcore.h>
@@ -29,8 +30,10 @@ struct QueryContext {
 
     RTCIntersectContext embree;
     const Ray* rays = nullptr;
-    double best_t[Accelerator::packet_size] = {};  ///< nearest analytic hit so far per ray (double)
-    Vec3 best_normal[Accelerator::packet_size];    ///< and its normal, so it is not computed twice
+    /// Nearest analytic hit so far per ray (double), set by intersect queries before tracing,
+    /// and its normal, so it is not computed twice (set with it).
+    double best_t[Accelerator::packet_size];
+    PacketArray<Vec3, Accelerator::packet_size> best_normal;
 };
 
 struct AnalyticGeometry {
@@ -311,9 +314,9 @@ struct Accelerator::Impl {
         alignas(64) RTCRayHit16 packet;
         for (int i = 0; i < packet_size; ++i) {
             valid[i] = (i < count && active[i]) ? -1 : 0;
-            const Ray& ray = rays[i < count ? i : 0];
-            context.best_t[i] = ray.t_max;
-            set_lane(packet.ray, i, ray);
+            if (!valid[i]) continue;  // Embree reads only the valid lanes
+            context.best_t[i] = rays[i].t_max;
+            set_lane(packet.ray, i, rays[i]);
             packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
             packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
         }
@@ -351,8 +354,7 @@ struct Accelerator::Impl {
             const bool query = i < count && active[i] && !(blocked[i] = occluded_by_plane(rays[i]));
             valid[i] = query ? -1 : 0;
             remaining += query;
-            const Ray& ray = rays[i < count ? i : 0];
-            set_lane(packet, i, ray);
+            if (query) set_lane(packet, i, rays[i]);  // Embree reads only the valid lanes
         }
         if (remaining == 0) return;
         rtcOccluded16(valid, rtc_scene, &context.embree, &packet);

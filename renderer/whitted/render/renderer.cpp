@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "whitted/render/renderer.h"
 
+#include "whitted/core/packet_array.h"
 #include "whitted/render/camera.h"
 
 #include <tbb/blocked_range.h>
@@ -17,8 +18,8 @@ namespace whitted {
 
 Color render_pixel(const Scene& scene, const LectureShading& shading, int i, int j, RayCounts& counts) {
     const int n = scene.samples;
-    Ray rays[Accelerator::packet_size];
-    Color radiance[Accelerator::packet_size];
+    PacketArray<Ray, Accelerator::packet_size> rays;
+    PacketArray<Color, Accelerator::packet_size> radiance;
     Color sum(0.0);
     int count = 0;
     for (int b = 0; b < n; ++b) {
@@ -27,7 +28,7 @@ Color render_pixel(const Scene& scene, const LectureShading& shading, int i, int
             sample_position(i, j, a, b, n, scene.width, scene.height, x0, y0);
             rays[count++] = camera_ray(scene.camera, x0, y0);
             if (count == Accelerator::packet_size || (a == n - 1 && b == n - 1)) {
-                shading.trace_packet(rays, count, 0, radiance, counts);
+                shading.trace_packet(rays.data(), count, 0, radiance.data(), counts);
                 for (int k = 0; k < count; ++k) sum += radiance[k];
                 counts.camera += count;
                 count = 0;
@@ -47,8 +48,8 @@ void render_block_single_sample(const Scene& scene, const LectureShading& shadin
     static_assert(side * side == Accelerator::packet_size);
     for (int by = y_begin; by < y_end; by += side) {
         for (int bx = x_begin; bx < x_end; bx += side) {
-            Ray rays[Accelerator::packet_size];
-            Color radiance[Accelerator::packet_size];
+            PacketArray<Ray, Accelerator::packet_size> rays;
+            PacketArray<Color, Accelerator::packet_size> radiance;
             int pixel_x[Accelerator::packet_size], pixel_y[Accelerator::packet_size];
             int count = 0;
             for (int y = by; y < std::min(by + side, y_end); ++y) {
@@ -60,7 +61,7 @@ void render_block_single_sample(const Scene& scene, const LectureShading& shadin
                     ++count;
                 }
             }
-            shading.trace_packet(rays, count, 0, radiance, counts);
+            shading.trace_packet(rays.data(), count, 0, radiance.data(), counts);
             counts.camera += count;
             for (int k = 0; k < count; ++k) {
                 float* out = &image.rgb[3 * (size_t(pixel_y[k]) * scene.width + pixel_x[k])];

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "whitted/render/shading.h"
 
+#include "whitted/core/packet_array.h"
+
 #include <cmath>
 
 namespace whitted {
@@ -57,7 +59,7 @@ void LectureShading::direct_lighting(const SurfaceHit* hits, const Ray* rays, co
         local[i] = m_scene.materials[hits[i].material].ka * m_scene.ambient;  // ambient: ka·Ia
     }
     for (const Light& light : m_scene.lights) {
-        Ray shadow_rays[packet_size];
+        PacketArray<Ray, packet_size> shadow_rays;  // set where `query`
         bool query[packet_size] = {}, blocked[packet_size] = {}, lit[packet_size] = {};
         double n_dot_l[packet_size];
         for (int i = 0; i < count; ++i) {
@@ -83,7 +85,7 @@ void LectureShading::direct_lighting(const SurfaceHit* hits, const Ray* rays, co
             query[i] = shadow_rays[i].t_max > shadow_rays[i].t_min;  // else the light is on the surface: unblocked
             counts.shadow += query[i];
         }
-        m_accelerator.occluded_packet(shadow_rays, query, count, blocked);
+        m_accelerator.occluded_packet(shadow_rays.data(), query, count, blocked);
         for (int i = 0; i < count; ++i) {
             if (!lit[i] || (query[i] && blocked[i])) continue;  // a blocked light adds neither term
             const Material& material = m_scene.materials[hits[i].material];
@@ -98,8 +100,8 @@ void LectureShading::direct_lighting(const SurfaceHit* hits, const Ray* rays, co
 
 void LectureShading::trace_packet(const Ray* first_rays, int count, int hits_so_far, Color* radiance,
                                   RayCounts& counts) const {
-    Ray rays[packet_size];
-    Color weight[packet_size];  // product of the mirror coefficients along the path so far
+    PacketArray<Ray, packet_size> rays;
+    PacketArray<Color, packet_size> weight;  // product of the mirror coefficients along the path so far
     bool active[packet_size] = {};
     for (int i = 0; i < count; ++i) {
         rays[i] = first_rays[i];
@@ -110,9 +112,9 @@ void LectureShading::trace_packet(const Ray* first_rays, int count, int hits_so_
     // A path segment past the last allowed surface hit contributes black, not the background
     // (POV-Ray's max_trace_level semantics, scene-format v1 `render.max_depth`).
     for (int level = hits_so_far; level < m_scene.max_depth; ++level) {
-        SurfaceHit hits[packet_size];
+        PacketArray<SurfaceHit, packet_size> hits;  // set where `found`
         bool found[packet_size] = {};
-        m_accelerator.intersect_packet(rays, active, count, hits, found);
+        m_accelerator.intersect_packet(rays.data(), active, count, hits.data(), found);
         bool any_hit = false;
         for (int i = 0; i < count; ++i) {
             if (active[i] && !found[i]) {
@@ -123,9 +125,9 @@ void LectureShading::trace_packet(const Ray* first_rays, int count, int hits_so_
         }
         if (!any_hit) break;
 
-        Color local[packet_size];
-        Vec3 normal[packet_size];
-        direct_lighting(hits, rays, active, count, local, normal, counts);
+        PacketArray<Color, packet_size> local;  // set where `active`
+        PacketArray<Vec3, packet_size> normal;
+        direct_lighting(hits.data(), rays.data(), active, count, local.data(), normal.data(), counts);
         for (int i = 0; i < count; ++i) {
             if (!active[i]) continue;
             radiance[i] += weight[i] * local[i];
