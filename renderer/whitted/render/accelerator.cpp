@@ -169,20 +169,20 @@ struct Accelerator::Impl {
     std::vector<uint32_t> mesh_of_geometry;
     AnalyticGeometry spheres{ShapeKind::spheres, nullptr};
     AnalyticGeometry boxes{ShapeKind::boxes, nullptr};
+    RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;  ///< of the scene and its meshes (build_quality)
 
     Impl(const Scene& s, int threads) : scene(s) {
         spheres.scene = boxes.scene = &scene;
         // Embree gets the render's thread count (--threads): its setting limits the whole
         // process's TBB threads (with threads=1 the render ran at half speed), so the two must
-        // agree. The 1M-triangle build still takes 0.13 s or, one run in four, about 0.28 s.
+        // agree.
         const std::string config = "verbose=0,threads=" + std::to_string(threads);
         device = rtcNewDevice(config.c_str());
         if (!device) throw std::runtime_error("cannot create the Embree device");
         rtcSetDeviceErrorFunction(device, record_embree_error, &embree_error);
         rtc_scene = rtcNewScene(device);
-        // Medium quality: for 1M triangles HIGH took 2.0 s to build against 0.2 s, for a few
-        // percent faster traversal that a single frame cannot win back.
-        rtcSetSceneBuildQuality(rtc_scene, RTC_BUILD_QUALITY_MEDIUM);
+        quality = build_quality();
+        rtcSetSceneBuildQuality(rtc_scene, quality);
         for (uint32_t m = 0; m < scene.meshes.size(); ++m) add_mesh(m);
         if (!scene.spheres.empty()) add_analytic(spheres, scene.spheres.size());
         if (!scene.boxes.empty()) add_analytic(boxes, scene.boxes.size());
@@ -194,6 +194,20 @@ struct Accelerator::Impl {
     }
 
     ~Impl() { release(); }
+
+    /// A BVH is built once per triangle and traversed once per ray. HIGH quality took 2.0 s to
+    /// build 1M triangles against 0.2 s for MEDIUM, for a few percent faster traversal that a
+    /// single frame cannot win back. On the 1M-triangle anchor (2 threads, 1280x960) LOW built
+    /// in 0.06 s against 0.15 s and rendered 0.02 s (10 %) slower; on the 100k-triangle one the
+    /// two came out even, and on the 100 spheres LOW rendered 15-25 % slower (docs/performance.md).
+    /// So LOW once the triangles outnumber a quarter of the camera rays. The BVH only changes
+    /// the order in which candidates are met: the 1M-triangle image came out bit-identical.
+    RTCBuildQuality build_quality() const {
+        size_t triangles = 0;
+        for (const TriangleMesh& mesh : scene.meshes) triangles += mesh.triangle_count();
+        const double camera_rays = double(scene.width) * scene.height * scene.samples * scene.samples;
+        return double(triangles) > camera_rays / 4 ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM;
+    }
 
     void release() {
         if (rtc_scene) rtcReleaseScene(rtc_scene);
@@ -210,6 +224,7 @@ struct Accelerator::Impl {
                                    4 * sizeof(float), mesh.vertex_count());
         rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.indices.data(), 0,
                                    3 * sizeof(uint32_t), mesh.triangle_count());
+        rtcSetGeometryBuildQuality(geometry, quality);  // Embree builds LOW only if both say so
         rtcCommitGeometry(geometry);
         const unsigned id = rtcAttachGeometry(rtc_scene, geometry);
         rtcReleaseGeometry(geometry);
