@@ -325,6 +325,9 @@ public:
                     next = read_normal(keyword + 3, end);
                 } else if (keyword[0] == 'f' && keyword + 1 < end && is_blank(keyword[1])) {
                     next = read_face(keyword + 2, end, line_number);
+                } else if (keyword[0] == '#' ||
+                           (keyword[0] == 'v' && keyword + 2 < end && keyword[1] == 't' && is_blank(keyword[2]))) {
+                    next = next_line(keyword, end);  // comments and texture coordinates: not used
                 }
             }
             p = next ? next : read_statement(line_begin, end, line_number);
