@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// Writing images: an EXR holds the linear floats exactly, a finished image replaces an existing
-// one, and a failed write leaves the old file as it was and no temporary file behind.
+// Writing images: an EXR holds the linear floats exactly, a PNG the rounded display codes and
+// the metadata, a finished image replaces an existing one, and a failed write leaves the old
+// file as it was and no temporary file behind.
 
 #include "whitted/output/image_output.h"
 
@@ -11,7 +12,12 @@
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
 
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
 
 #include <filesystem>
 #include <fstream>
@@ -67,6 +73,48 @@ TEST(ImageOutput, ExrHoldsTheLinearFloatsExactly) {
     write_image(image, path, {});
     EXPECT_EQ(read_exr_rgb(path), image.rgb);
     EXPECT_EQ(entries(directory.path()), std::vector<std::string>{"new.exr"});
+}
+
+// The Raw view is the identity, so the file must hold round(clamp(v, 0, 1) * max) exactly; NaN
+// becomes 0. Read back with OpenImageIO, which does not share the writer's code.
+TEST(ImageOutput, PngHoldsTheRoundedDisplayCodes) {
+    const std::vector<float> values = {
+        -1.0f,    0.0f,   0.5f / 255, 0.49f / 255, 0.25f,
+        0.5f,     0.999f, 1.0f,       7.0f,        std::numeric_limits<float>::quiet_NaN(),
+        1.0f / 3, 0.7f};
+    Image image;
+    image.width = 2;
+    image.height = 2;
+    image.rgb = values;
+    const test::ScratchDirectory directory;
+    for (const int bits : {8, 16}) {
+        const std::string path = (directory.path() / ("raw" + std::to_string(bits) + ".png")).string();
+        OutputOptions options;
+        options.bit_depth = bits;
+        options.display = "sRGB";
+        options.view = "Raw";
+        options.metadata = {{"whitted:scene", "/tmp/sc\xc3\xa8ne.yaml"}};  // UTF-8: needs an iTXt chunk
+        write_image(image, path, options);
+
+        auto in = OIIO::ImageInput::open(path);
+        ASSERT_TRUE(in) << OIIO::geterror();
+        const OIIO::ImageSpec& spec = in->spec();
+        EXPECT_EQ(spec.width, 2);
+        EXPECT_EQ(spec.height, 2);
+        EXPECT_EQ(spec.nchannels, 3);
+        EXPECT_EQ(spec.format, bits == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
+        EXPECT_EQ(spec.get_string_attribute("Software"), "Whitted 0.1.0");
+        EXPECT_EQ(spec.get_string_attribute("whitted:scene"), "/tmp/sc\xc3\xa8ne.yaml");
+        std::vector<uint16_t> codes(values.size());
+        ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT16, codes.data())) << in->geterror();
+        const double max = bits == 16 ? 65535.0 : 255.0;
+        for (size_t i = 0; i < values.size(); ++i) {
+            const double v = std::isnan(values[i]) ? 0.0 : std::min(std::max(double(values[i]), 0.0), 1.0);
+            const double code = std::floor(v * max + 0.5);
+            // OpenImageIO widens 8-bit codes to 16 bits by c * 257.
+            EXPECT_EQ(codes[i], uint16_t(bits == 16 ? code : code * 257)) << bits << " bits, value " << values[i];
+        }
+    }
 }
 
 // The finished image is swapped in for the old one (renameat2 RENAME_EXCHANGE) and the old one

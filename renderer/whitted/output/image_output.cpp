@@ -4,6 +4,7 @@
 #include "whitted/output/color_management.h"
 
 #include "whitted/output/plugin.h"
+#include "whitted/output/png_file.h"
 
 #include <Imath/half.h>
 #include <OpenEXR/ImfChannelList.h>
@@ -14,6 +15,7 @@
 #include <OpenEXR/ImfThreading.h>
 
 #include <fcntl.h>
+#include <tbb/parallel_for.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -92,7 +94,7 @@ void check_output_path(const std::string& path) {
         throw std::invalid_argument("cannot write '" + path + "': it is a directory");
 }
 
-/// The plug-in's writer for display-referred files (8/16-bit PNG/JPEG/TIFF); see plugin.h.
+/// The plug-in's writer for JPEG and TIFF (8/16-bit); see plugin.h. PNG is written here (png_file.h).
 using WriteDisplayImage = std::string (*)(const std::string& format_path, const std::string& temp_path, int width,
                                           int height, const float* rgb, int bits,
                                           const std::vector<std::pair<std::string, std::string>>& metadata);
@@ -159,17 +161,28 @@ void write_image(const Image& image, const std::string& path, const OutputOption
     } else {
         std::vector<float> pixels = image.rgb;
         const DisplayTransform display(options.ocio_config, options.display, options.view);
-        display.apply(pixels.data(), pixels.size() / 3);
+        // OCIO's CPU processor may be applied from several threads at once: bands of rows.
+        constexpr size_t band = 32;
+        const size_t width = size_t(image.width);
+        tbb::parallel_for(size_t(0), (size_t(image.height) + band - 1) / band, [&](size_t b) {
+            const size_t first = b * band, rows = std::min(band, size_t(image.height) - first);
+            display.apply(pixels.data() + 3 * width * first, width * rows);
+        });
         const bool is_tiff = ext == ".tif" || ext == ".tiff";
         const int bits = options.bit_depth ? options.bit_depth : (is_tiff ? 16 : 8);
         if ((ext == ".jpg" || ext == ".jpeg") && bits != 8)
             throw std::invalid_argument("JPEG files hold 8 bits per channel only");
         metadata.push_back(
             {"whitted:colorspace", display.display() + " / " + display.view() + " (" + display.config_source() + ")"});
-        const auto write = reinterpret_cast<WriteDisplayImage>(image_io_plugin_symbol("whitted_write_display_image"));
-        const std::string error =
-            write(path, temporary.path(), image.width, image.height, pixels.data(), bits, metadata);
-        if (!error.empty()) throw std::runtime_error("cannot write '" + path + "': " + error);
+        if (ext == ".png") {
+            write_png(temporary.path(), image.width, image.height, pixels.data(), bits, metadata);
+        } else {
+            const auto write =
+                reinterpret_cast<WriteDisplayImage>(image_io_plugin_symbol("whitted_write_display_image"));
+            const std::string error =
+                write(path, temporary.path(), image.width, image.height, pixels.data(), bits, metadata);
+            if (!error.empty()) throw std::runtime_error("cannot write '" + path + "': " + error);
+        }
     }
     temporary.commit(path);
 }
