@@ -220,9 +220,11 @@ int run_render(const RenderArguments& args) {
             std::fprintf(
                 stderr,
                 "whitted: stages: parse %.3fs, validate+load %.3fs, build BVH %.3fs, render %.3fs, write %.3fs; "
-                "%zu triangles, %zu spheres, %zu boxes, %zu planes, %zu lights\n",
+                "%zu triangles, %zu spheres, %zu boxes, %zu planes, %zu lights; BVH %.1f MB (%.1f MB while "
+                "building)\n",
                 parse_seconds, validate_seconds, build_seconds, result.seconds, write_seconds, scene.triangle_count(),
-                scene.spheres.size(), scene.boxes.size(), scene.planes.size(), scene.lights.size());
+                scene.spheres.size(), scene.boxes.size(), scene.planes.size(), scene.lights.size(),
+                double(accelerator.embree_bytes()) / 1e6, double(accelerator.peak_embree_bytes()) / 1e6);
         if (!args.quiet)
             std::fprintf(stderr,
                          "whitted: %dx%d, %d sample(s)/pixel, %u thread(s): render %.3fs (total %.3fs), %.2f M rays "
@@ -336,7 +338,7 @@ int main(int argc, char** argv) {
     render_cmd->add_option("--display", render_args.display, "OCIO display (default: the config's default)");
     render_cmd->add_option("--view", render_args.view, "OCIO view (default: the display's default)");
     render_cmd->add_flag("--stats", render_args.stats,
-                         "Print the time of each stage (parse, load, BVH, render, write)");
+                         "Print the time of each stage (parse, load, BVH, render, write) and the BVH's memory");
     render_cmd->add_flag("--partial", render_args.partial,
                          "If interrupted, still write what was finished (marked partial in the metadata)");
 

@@ -7,6 +7,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -159,9 +160,25 @@ Vec3 vertex_normal(const TriangleMesh& mesh, uint32_t index) {
 
 }  // namespace
 
+/// Embree's own allocations, counted as they happen (--stats reports the peak: the BVH and
+/// its build's scratch memory).
+struct MemoryCount {
+    std::atomic<int64_t> current{0}, peak{0};
+};
+
+bool count_embree_memory(void* user, ssize_t bytes, bool /*post*/) {
+    auto* count = static_cast<MemoryCount*>(user);
+    const int64_t now = count->current.fetch_add(bytes) + bytes;
+    int64_t peak = count->peak.load();
+    while (now > peak && !count->peak.compare_exchange_weak(peak, now)) {
+    }
+    return true;  // never refuse: the limit is the machine's
+}
+
 struct Accelerator::Impl {
     const Scene& scene;
     std::string embree_error;  ///< first error Embree reported (see record_embree_error)
+    MemoryCount memory;
     RTCDevice device = nullptr;
     RTCScene rtc_scene = nullptr;
     // geomID → what it is: a mesh index, or the sphere/box user geometry.
@@ -180,6 +197,7 @@ struct Accelerator::Impl {
         device = rtcNewDevice(config.c_str());
         if (!device) throw std::runtime_error("cannot create the Embree device");
         rtcSetDeviceErrorFunction(device, record_embree_error, &embree_error);
+        rtcSetDeviceMemoryMonitorFunction(device, count_embree_memory, &memory);
         rtc_scene = rtcNewScene(device);
         quality = build_quality();
         rtcSetSceneBuildQuality(rtc_scene, quality);
@@ -382,6 +400,12 @@ Accelerator::Accelerator(const Scene& scene, int threads)
     : m_impl(std::make_unique<Impl>(scene,
                                     threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency())))) {}
 Accelerator::~Accelerator() = default;
+size_t Accelerator::peak_embree_bytes() const {
+    return size_t(std::max<int64_t>(0, m_impl->memory.peak.load()));
+}
+size_t Accelerator::embree_bytes() const {
+    return size_t(std::max<int64_t>(0, m_impl->memory.current.load()));
+}
 bool Accelerator::intersect(const Ray& ray, SurfaceHit& hit) const {
     return m_impl->intersect(ray, hit);
 }

@@ -37,6 +37,10 @@ public:
     /// occluded() gives for that ray alone, up to Embree's float choice between two triangles
     /// meeting at an edge.
     static constexpr int packet_size = 16;
+
+    /// Bytes Embree holds now (the BVH), and the most it held while building.
+    size_t embree_bytes() const;
+    size_t peak_embree_bytes() const;
     void intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found) const;
     void occluded_packet(const Ray* rays, const bool* active, int count, bool* blocked) const;
 
