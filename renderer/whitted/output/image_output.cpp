@@ -159,15 +159,7 @@ void write_image(const Image& image, const std::string& path, const OutputOption
         metadata.push_back({"whitted:colorspace", "Linear Rec.709 (sRGB), scene-referred"});
         write_exr(image, temporary.path(), options.half, exr_compression(options.exr_compression), metadata);
     } else {
-        std::vector<float> pixels = image.rgb;
         const DisplayTransform display(options.ocio_config, options.display, options.view);
-        // OCIO's CPU processor may be applied from several threads at once: bands of rows.
-        constexpr size_t band = 32;
-        const size_t width = size_t(image.width);
-        tbb::parallel_for(size_t(0), (size_t(image.height) + band - 1) / band, [&](size_t b) {
-            const size_t first = b * band, rows = std::min(band, size_t(image.height) - first);
-            display.apply(pixels.data() + 3 * width * first, width * rows);
-        });
         const bool is_tiff = ext == ".tif" || ext == ".tiff";
         const int bits = options.bit_depth ? options.bit_depth : (is_tiff ? 16 : 8);
         if ((ext == ".jpg" || ext == ".jpeg") && bits != 8)
@@ -175,8 +167,16 @@ void write_image(const Image& image, const std::string& path, const OutputOption
         metadata.push_back(
             {"whitted:colorspace", display.display() + " / " + display.view() + " (" + display.config_source() + ")"});
         if (ext == ".png") {
-            write_png(temporary.path(), image.width, image.height, pixels.data(), bits, metadata);
+            write_png(temporary.path(), image, display, bits, metadata);
         } else {
+            std::vector<float> pixels = image.rgb;
+            // OCIO's CPU processor may be applied from several threads at once: bands of rows.
+            constexpr size_t band = 32;
+            const size_t width = size_t(image.width);
+            tbb::parallel_for(size_t(0), (size_t(image.height) + band - 1) / band, [&](size_t b) {
+                const size_t first = b * band, rows = std::min(band, size_t(image.height) - first);
+                display.apply(pixels.data() + 3 * width * first, width * rows);
+            });
             const auto write =
                 reinterpret_cast<WriteDisplayImage>(image_io_plugin_symbol("whitted_write_display_image"));
             const std::string error =

@@ -71,23 +71,29 @@ bool is_ascii(const std::string& text) {
 
 }  // namespace
 
-void write_png(const std::string& path, int width, int height, const float* rgb, int bits,
+void write_png(const std::string& path, const Image& linear, const DisplayTransform& display, int bits,
                const std::vector<std::pair<std::string, std::string>>& metadata) {
     if (bits != 8 && bits != 16) throw std::invalid_argument("PNG files hold 8 or 16 bits per channel");
-    // Codes: round to nearest after clamping to [0, 1] (NaN becomes 0), big-endian for 16 bits.
+    const int width = linear.width, height = linear.height;
     const size_t samples_per_row = 3 * size_t(width);
     const size_t row_bytes = samples_per_row * size_t(bits / 8);
     std::vector<unsigned char> rows(row_bytes * size_t(height));
     // In double, the product and the half are exact, so every value rounds to its nearest code
     // (in float, 0.7f * 255 + 0.5f came out 179, not 178).
     const double scale = bits == 16 ? 65535.0 : 255.0;
-    tbb::parallel_for(0, height, [&](int y) {
-        const float* in = rgb + size_t(y) * samples_per_row;
-        unsigned char* out = rows.data() + size_t(y) * row_bytes;
-        for (size_t i = 0; i < samples_per_row; ++i) {
-            const float v = in[i] > 0 ? std::min(in[i], 1.0f) : 0.0f;
+    // Bands of rows on all cores (OCIO's CPU processor may be applied from several threads at
+    // once), each through a small buffer rather than a display-referred copy of the whole image.
+    constexpr int band = 8;
+    tbb::parallel_for(0, (height + band - 1) / band, [&](int b) {
+        const int first = b * band, count = std::min(band, height - first);
+        std::vector<float> values(linear.rgb.begin() + std::ptrdiff_t(samples_per_row * size_t(first)),
+                                  linear.rgb.begin() + std::ptrdiff_t(samples_per_row * size_t(first + count)));
+        display.apply(values.data(), size_t(width) * size_t(count));
+        unsigned char* out = rows.data() + row_bytes * size_t(first);
+        for (size_t i = 0; i < values.size(); ++i) {
+            const float v = values[i] > 0 ? std::min(values[i], 1.0f) : 0.0f;  // NaN fails `> 0`
             const auto code = static_cast<uint32_t>(double(v) * scale + 0.5);
-            if (bits == 16) {
+            if (bits == 16) {  // PNG samples are big-endian
                 out[2 * i] = static_cast<unsigned char>(code >> 8);
                 out[2 * i + 1] = static_cast<unsigned char>(code & 0xFF);
             } else {
