@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: MIT
 """Times Whitted against POV-Ray 3.7 on the anchor scenes (bench/generate.py), interleaved,
 whole process, median of N runs; checks that the two images agree; prints a table.
-Usage: bench/run.py WHITTED_BINARY OUT_DIR [--runs N] [--threads T] [--scenes a,b]"""
+Usage: bench/run.py WHITTED_BINARY OUT_DIR [--runs N] [--threads T] [--scenes a,b] [--format exr|png]"""
 import argparse
 import os
 import re
@@ -35,6 +35,8 @@ def main():
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--threads", type=int, default=os.cpu_count())
     ap.add_argument("--scenes", default="spheres,torus100k,torus1m")
+    ap.add_argument("--format", choices=["exr", "png"], default="exr",
+                    help="Whitted's output: float EXR, or a linear 16-bit PNG like POV-Ray's")
     args = ap.parse_args()
     out = Path(args.out).resolve()
     here = Path(__file__).resolve().parent
@@ -54,10 +56,12 @@ def main():
         scene = out / f"{name}.yaml"
         pov = out / f"{name}.pov"
         subprocess.run([args.whitted, "convert", str(scene), str(pov)], check=True, stderr=subprocess.DEVNULL)
-        ours_img, theirs_img = out / f"{name}.whitted.exr", out / f"{name}.povray.png"
+        ours_img, theirs_img = out / f"{name}.whitted.{args.format}", out / f"{name}.povray.png"
         pov_cmd = [povray, f"+I{pov.name}", f"+O{theirs_img.name}", "+W1280", "+H960", "-D", "-A", "+Q9", "+FN16",
                    "File_Gamma=1.0", f"+WT{args.threads}", "-GA"]
         our_cmd = [args.whitted, "render", str(scene), "-o", str(ours_img), "--threads", str(args.threads)]
+        if args.format == "png":  # the same file as POV-Ray's: linear (the Raw view), 16 bits
+            our_cmd += ["--view", "Raw", "--bit-depth", "16"]
         pov_times, our_times, our_peak, rays = [], [], 0.0, 0.0
         for _ in range(args.runs):  # interleaved, so both see the same machine state
             wall, _, _ = timed(pov_cmd, cwd=out, env=env)
