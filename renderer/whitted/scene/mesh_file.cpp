@@ -335,8 +335,8 @@ public:
     }
 
     std::vector<uint32_t> position_index;  ///< 3 per triangle
-    /// 3 per triangle, UINT32_MAX where a corner has none; empty while every corner so far names
-    /// the normal with its position's number (the usual export), which then needs no copy.
+    /// 3 per triangle; empty while every corner so far names the normal with its position's
+    /// number (the usual export), which then needs no copy, and once a corner has no normal.
     std::vector<uint32_t> normal_index;
     std::vector<int32_t> face_material;  ///< 1 per triangle
     bool every_corner_has_normal = true;
@@ -428,9 +428,13 @@ private:
     }
 
     void add_face(const uint32_t* positions, const uint32_t* normals, int corners, int line_number) {
-        for (int k = 0; k < corners; ++k) {
+        for (int k = 0; k < corners; ++k)
             if (normals[k] == no_normal) every_corner_has_normal = false;
-            if (normals_follow_positions && normals[k] != positions[k]) {
+        // A corner without a normal makes the mesh flat: normal numbers are no longer needed.
+        const bool keep_normals = every_corner_has_normal;
+        if (!keep_normals && !normal_index.empty()) std::vector<uint32_t>().swap(normal_index);
+        for (int k = 0; keep_normals && normals_follow_positions && k < corners; ++k) {
+            if (normals[k] != positions[k]) {
                 normals_follow_positions = false;
                 normal_index = position_index;  // until now they were the same
             }
@@ -438,7 +442,7 @@ private:
         for (int k = 1; k + 1 < corners; ++k) {  // fan from the first corner
             for (const int c : {0, k, k + 1}) {
                 position_index.push_back(positions[c]);
-                if (!normals_follow_positions) normal_index.push_back(normals[c]);
+                if (keep_normals && !normals_follow_positions) normal_index.push_back(normals[c]);
             }
             face_material.push_back(m_current_material);
         }
