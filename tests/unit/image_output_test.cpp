@@ -75,45 +75,59 @@ TEST(ImageOutput, ExrHoldsTheLinearFloatsExactly) {
     EXPECT_EQ(entries(directory.path()), std::vector<std::string>{"new.exr"});
 }
 
-// The Raw view is the identity, so the file must hold round(clamp(v, 0, 1) * max) exactly; NaN
-// becomes 0. Read back with OpenImageIO, which does not share the writer's code.
+/// Writes `image` as a PNG through the Raw view (the identity) and reads it back with
+/// OpenImageIO, which does not share the writer's code: the spec, and every value as a 16-bit
+/// code (OpenImageIO widens an 8-bit code c to c·257).
+std::vector<uint16_t> raw_png_codes(const Image& image, const std::string& path, int bits, OIIO::ImageSpec& spec,
+                                    const std::vector<std::pair<std::string, std::string>>& metadata = {}) {
+    OutputOptions options;
+    options.bit_depth = bits;
+    options.display = "sRGB";
+    options.view = "Raw";
+    options.metadata = metadata;
+    write_image(image, path, options);
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) {
+        ADD_FAILURE() << OIIO::geterror();
+        return {};
+    }
+    spec = in->spec();
+    std::vector<uint16_t> codes(image.rgb.size());
+    if (!in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT16, codes.data())) ADD_FAILURE() << in->geterror();
+    return codes;
+}
+
+/// round(clamp(v, 0, 1) · max), NaN as 0, widened to 16 bits as OpenImageIO reads it.
+uint16_t expected_code(float value, int bits) {
+    const double v = std::isnan(value) ? 0.0 : std::min(std::max(double(value), 0.0), 1.0);
+    const double code = std::floor(v * (bits == 16 ? 65535.0 : 255.0) + 0.5);
+    return uint16_t(bits == 16 ? code : code * 257);
+}
+
+// The file must hold each value's nearest code (0.7f is 178 in 8 bits, not 179) and the
+// metadata, a UTF-8 value included (an iTXt chunk).
 TEST(ImageOutput, PngHoldsTheRoundedDisplayCodes) {
-    const std::vector<float> values = {
-        -1.0f,    0.0f,   0.5f / 255, 0.49f / 255, 0.25f,
-        0.5f,     0.999f, 1.0f,       7.0f,        std::numeric_limits<float>::quiet_NaN(),
-        1.0f / 3, 0.7f};
     Image image;
     image.width = 2;
     image.height = 2;
-    image.rgb = values;
+    image.rgb = {-1.0f,    0.0f,   0.5f / 255, 0.49f / 255, 0.25f,
+                 0.5f,     0.999f, 1.0f,       7.0f,        std::numeric_limits<float>::quiet_NaN(),
+                 1.0f / 3, 0.7f};
     const test::ScratchDirectory directory;
     for (const int bits : {8, 16}) {
-        const std::string path = (directory.path() / ("raw" + std::to_string(bits) + ".png")).string();
-        OutputOptions options;
-        options.bit_depth = bits;
-        options.display = "sRGB";
-        options.view = "Raw";
-        options.metadata = {{"whitted:scene", "/tmp/sc\xc3\xa8ne.yaml"}};  // UTF-8: needs an iTXt chunk
-        write_image(image, path, options);
-
-        auto in = OIIO::ImageInput::open(path);
-        ASSERT_TRUE(in) << OIIO::geterror();
-        const OIIO::ImageSpec& spec = in->spec();
+        OIIO::ImageSpec spec;
+        const std::vector<uint16_t> codes =
+            raw_png_codes(image, (directory.path() / ("raw" + std::to_string(bits) + ".png")).string(), bits, spec,
+                          {{"whitted:scene", "/tmp/sc\xc3\xa8ne.yaml"}});
+        ASSERT_EQ(codes.size(), image.rgb.size());
         EXPECT_EQ(spec.width, 2);
         EXPECT_EQ(spec.height, 2);
         EXPECT_EQ(spec.nchannels, 3);
         EXPECT_EQ(spec.format, bits == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
         EXPECT_EQ(spec.get_string_attribute("Software"), "Whitted 0.1.0");
         EXPECT_EQ(spec.get_string_attribute("whitted:scene"), "/tmp/sc\xc3\xa8ne.yaml");
-        std::vector<uint16_t> codes(values.size());
-        ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT16, codes.data())) << in->geterror();
-        const double max = bits == 16 ? 65535.0 : 255.0;
-        for (size_t i = 0; i < values.size(); ++i) {
-            const double v = std::isnan(values[i]) ? 0.0 : std::min(std::max(double(values[i]), 0.0), 1.0);
-            const double code = std::floor(v * max + 0.5);
-            // OpenImageIO widens 8-bit codes to 16 bits by c * 257.
-            EXPECT_EQ(codes[i], uint16_t(bits == 16 ? code : code * 257)) << bits << " bits, value " << values[i];
-        }
+        for (size_t i = 0; i < codes.size(); ++i)
+            EXPECT_EQ(codes[i], expected_code(image.rgb[i], bits)) << bits << " bits, value " << image.rgb[i];
     }
 }
 
@@ -131,22 +145,12 @@ TEST(ImageOutput, PngOfManyBandsReadsBackExactly) {
     }
     const test::ScratchDirectory directory;
     for (const int bits : {8, 16}) {
-        const std::string path = (directory.path() / ("bands" + std::to_string(bits) + ".png")).string();
-        OutputOptions options;
-        options.bit_depth = bits;
-        options.display = "sRGB";
-        options.view = "Raw";
-        write_image(image, path, options);
-        auto in = OIIO::ImageInput::open(path);
-        ASSERT_TRUE(in) << OIIO::geterror();
-        std::vector<uint16_t> codes(image.rgb.size());
-        ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT16, codes.data())) << in->geterror();
-        const double max = bits == 16 ? 65535.0 : 255.0;
+        OIIO::ImageSpec spec;
+        const std::vector<uint16_t> codes =
+            raw_png_codes(image, (directory.path() / ("bands" + std::to_string(bits) + ".png")).string(), bits, spec);
+        ASSERT_EQ(codes.size(), image.rgb.size());
         size_t wrong = 0;
-        for (size_t i = 0; i < codes.size(); ++i) {
-            const double code = std::floor(std::min(double(image.rgb[i]), 1.0) * max + 0.5);
-            wrong += codes[i] != uint16_t(bits == 16 ? code : code * 257);
-        }
+        for (size_t i = 0; i < codes.size(); ++i) wrong += codes[i] != expected_code(image.rgb[i], bits);
         EXPECT_EQ(wrong, 0u) << bits << " bits";
     }
 }
