@@ -10,6 +10,7 @@
 #include "converters/pov_writer.h"
 
 #include "whitted/core/ray.h"
+#include "whitted/output/atomic_files.h"
 #include "whitted/scene/mesh_file.h"
 #include "whitted/scene/scene.h"
 
@@ -18,7 +19,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <map>
 #include <stdexcept>
@@ -341,18 +341,8 @@ std::string write_pov_files(const SceneDescription& d, const std::string& pov_pa
     image.replace_extension(options.hdr_output ? ".exr" : ".png");
     const std::string sdl = scene_to_sdl(d, options);
     const std::string ini_text = ini_for(d, pov.filename().string(), image.string(), options);
-    for (const auto& [path, text] : {std::pair{pov, &sdl}, std::pair{ini, &ini_text}}) {
-        const std::filesystem::path temporary = path.string() + ".tmp";
-        {
-            std::ofstream out(temporary, std::ios::binary);
-            out << *text;
-            if (!out) {
-                std::filesystem::remove(temporary);
-                throw std::runtime_error("cannot write '" + path.string() + "'");
-            }
-        }
-        std::filesystem::rename(temporary, path);
-    }
+    // Both files appear complete or not at all, even if the program is interrupted or killed.
+    write_files_atomically({{pov, sdl}, {ini, ini_text}});
     return ini.string();
 }
 

@@ -248,6 +248,9 @@ int run_render(const RenderArguments& args) {
 }
 
 int run_convert(const std::string& scene_path, const std::string& output) {
+    // SIGINT/SIGTERM end the program at once (130/143): the files are written unnamed and only
+    // named when complete (write_files_atomically), so there is nothing to clean up.
+    install_signal_handlers();
     try {
         const std::string ext = std::filesystem::path(output).extension().string();
         if (ext != ".pov")

@@ -5,7 +5,10 @@
     byte-for-byte intact, no temporary file left;
   - SIGKILL after 1.5 s: the previous output byte-for-byte intact;
   - SIGINT after 1 s during heavy_tile.yaml, whose every 16x16 tile takes over a minute
-    (256 samples x 256 mirror bounces x 49 lights per pixel): still exit 130 within 2 s.
+    (256 samples x 256 mirror bounces x 49 lights per pixel): still exit 130 within 2 s;
+  - `whitted convert` of a 720k-triangle mesh interrupted (SIGINT, SIGTERM, SIGKILL) at five
+    points of its run: each of the .pov and .ini is the previous one or the complete new one,
+    and no temporary file is left, even after SIGKILL.
 Usage: signal_test.py WHITTED [--threads N]"""
 
 import argparse
@@ -76,6 +79,59 @@ def run(whitted, directory, threads, sig, after, scene_text):
     return problems, took
 
 
+def grid_obj(path, n):
+    """An n x n grid of quads as 2 n^2 triangles, with normals: a large OBJ quickly."""
+    with open(path, "w") as f:
+        f.write("".join(f"v {i / n:.6f} {0.1 * ((i * j) % 7) / n:.6f} {j / n:.6f}\n"
+                        for i in range(n + 1) for j in range(n + 1)))
+        f.write("".join(f"vn 0 1 {((i + j) % 5) / 50:.6f}\n" for i in range(n + 1) for j in range(n + 1)))
+        faces = []
+        for i in range(n):
+            for j in range(n):
+                a, b, c, d = i * (n + 1) + j + 1, (i + 1) * (n + 1) + j + 1, (i + 1) * (n + 1) + j + 2, i * (n + 1) + j + 2
+                faces.append(f"f {a}//{a} {b}//{b} {c}//{c}\nf {a}//{a} {c}//{c} {d}//{d}\n")
+        f.write("".join(faces))
+
+
+def convert_cases(whitted, directory):
+    """Interrupts `whitted convert` at several points; returns the problems found."""
+    grid_obj(os.path.join(directory, "grid.obj"), 600)
+    scene = os.path.join(directory, "mesh.yaml")
+    with open(scene, "w") as f:
+        f.write("version: 1\ncamera: { eye: [0.5, 2, 2], look_at: [0.5, 0, 0.5] }\n"
+                "image: { width: 64, height: 48 }\nlights:\n  - { type: point, position: [0, 5, 0] }\n"
+                "materials:\n  m: { kd: 0.5 }\nobjects:\n  - { type: mesh, file: grid.obj, material: m }\n")
+    pov, ini = os.path.join(directory, "out.pov"), os.path.join(directory, "out.ini")
+    started = time.monotonic()
+    subprocess.run([whitted, "convert", scene, pov], check=True, stderr=subprocess.DEVNULL)
+    duration = time.monotonic() - started
+    complete = {pov: open(pov, "rb").read(), ini: open(ini, "rb").read()}
+    expected_files = {"grid.obj", "mesh.yaml", "out.pov", "out.ini"}
+    problems = []
+    for sig, fraction in ((signal.SIGINT, 0.3), (signal.SIGTERM, 0.6), (signal.SIGINT, 0.8),
+                          (signal.SIGINT, 0.95), (signal.SIGKILL, 0.8)):
+        for path in (pov, ini):
+            with open(path, "wb") as f:
+                f.write(OLD_BYTES)
+        process = subprocess.Popen([whitted, "convert", scene, pov], stderr=subprocess.DEVNULL)
+        time.sleep(duration * fraction)
+        process.send_signal(sig)
+        process.wait(timeout=20)
+        allowed = {0, 128 + sig.value} if sig != signal.SIGKILL else {0, -signal.SIGKILL.value}
+        if process.returncode not in allowed:
+            problems.append(f"convert, {sig.name} at {fraction:.0%}: exit {process.returncode}")
+        for path in (pov, ini):
+            if open(path, "rb").read() not in (OLD_BYTES, complete[path]):
+                problems.append(f"convert, {sig.name} at {fraction:.0%}: {os.path.basename(path)} is neither "
+                                "the previous file nor the complete new one")
+        leftovers = sorted(set(os.listdir(directory)) - expected_files)
+        if leftovers:
+            problems.append(f"convert, {sig.name} at {fraction:.0%}: files left behind: {leftovers}")
+        print(f"convert ({duration:.2f} s uninterrupted), {sig.name} at {fraction:.0%}: exit {process.returncode}"
+              + ("" if problems else ", ok"))
+    return problems
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("whitted")
@@ -90,6 +146,8 @@ def main():
             problems, took = run(args.whitted, directory, args.threads, sig, after, text)
             print(f"{name} render, {sig.name} after {after} s: stopped in {took:.3f} s" + ("" if problems else ", ok"))
             failures += problems
+    with tempfile.TemporaryDirectory(prefix="whitted-signal-convert-") as directory:
+        failures += convert_cases(args.whitted, directory)
     for problem in failures:
         print("FAIL " + problem)
     sys.exit(1 if failures else 0)

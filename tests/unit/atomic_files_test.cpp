@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: MIT
+// Files written so that they appear complete or not at all (`whitted convert`'s .pov and .ini):
+// the bytes land exactly, existing files are replaced, and a failure leaves no temporary file.
+
+#include "whitted/output/atomic_files.h"
+
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace whitted {
+namespace {
+
+std::string bytes_of(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    return bytes.str();
+}
+
+std::vector<std::string> entries(const std::filesystem::path& directory) {
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(directory))
+        names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+TEST(AtomicFiles, WritesEveryByteAndNothingElse) {
+    const test::ScratchDirectory directory;
+    std::string big(3 << 20, '\0');  // larger than one write() may take
+    for (size_t i = 0; i < big.size(); ++i) big[i] = char(i * 131 % 251);
+    write_files_atomically({{directory.path() / "a.pov", "camera {}\n"}, {directory.path() / "a.ini", big}});
+    EXPECT_EQ(bytes_of(directory.path() / "a.pov"), "camera {}\n");
+    EXPECT_EQ(bytes_of(directory.path() / "a.ini"), big);
+    EXPECT_EQ(entries(directory.path()), (std::vector<std::string>{"a.ini", "a.pov"}));
+}
+
+TEST(AtomicFiles, ReplacesExistingFiles) {
+    const test::ScratchDirectory directory;
+    write_files_atomically({{directory.path() / "s.pov", "old"}});
+    write_files_atomically({{directory.path() / "s.pov", "new, longer"}});
+    EXPECT_EQ(bytes_of(directory.path() / "s.pov"), "new, longer");
+    EXPECT_EQ(entries(directory.path()), std::vector<std::string>{"s.pov"});
+}
+
+TEST(AtomicFiles, MissingDirectoryThrowsAndWritesNothing) {
+    const test::ScratchDirectory directory;
+    EXPECT_THROW(write_files_atomically({{directory.path() / "a.pov", "x"}, {directory.path() / "no/b.ini", "y"}}),
+                 std::runtime_error);
+    EXPECT_TRUE(entries(directory.path()).empty()) << "a.pov must not appear when b.ini cannot be written";
+}
+
+TEST(AtomicFiles, FailedRenameLeavesNoTemporaryFile) {
+    const test::ScratchDirectory directory;
+    std::filesystem::create_directory(directory.path() / "taken.ini");  // a directory: the rename fails
+    try {
+        write_files_atomically({{directory.path() / "taken.ini", "x"}});
+        ADD_FAILURE() << "a directory was replaced by a file";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("taken.ini"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(entries(directory.path()), std::vector<std::string>{"taken.ini"});
+}
+
+}  // namespace
+}  // namespace whitted
