@@ -78,5 +78,35 @@ TEST(Render, ImageHoldsRenderPixelValues) {
     }
 }
 
+// --stats reports Embree's memory: a BVH over a few thousand triangles holds tens of kilobytes
+// at least (more than the triangles' own 36 bytes each), and the build's peak is no less.
+TEST(Render, AcceleratorReportsEmbreeMemory) {
+    std::string vertices, triangles;
+    constexpr int n = 40;  // an n x n grid of quads: 3200 triangles
+    for (int i = 0; i <= n; ++i)
+        for (int j = 0; j <= n; ++j)
+            vertices += (vertices.empty() ? "" : ", ") + std::string("[") + std::to_string(i) + ", 0, " +
+                        std::to_string(j) + "]";
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            const int a = i * (n + 1) + j, b = a + n + 1;
+            triangles += (triangles.empty() ? "" : ", ") + std::string("[") + std::to_string(a) + ", " +
+                         std::to_string(b) + ", " + std::to_string(b + 1) + "], [" + std::to_string(a) + ", " +
+                         std::to_string(b + 1) + ", " + std::to_string(a + 1) + "]";
+        }
+    const Scene scene = test::scene_from(test::join_lines({
+        "camera: {eye: [20, 10, 60], look_at: [20, 0, 20]}",
+        "image: {width: 8, height: 8}",
+        "materials:",
+        "  m: {kd: 0.5}",
+        "objects:",
+        "  - {type: mesh, material: m, vertices: [" + vertices + "], triangles: [" + triangles + "]}",
+    }));
+    ASSERT_EQ(scene.triangle_count(), size_t(2 * n * n));
+    const Accelerator accelerator(scene, 1);
+    EXPECT_GT(accelerator.embree_bytes(), size_t(36 * 2 * n * n));
+    EXPECT_GE(accelerator.peak_embree_bytes(), accelerator.embree_bytes());
+}
+
 }  // namespace
 }  // namespace whitted

@@ -158,8 +158,6 @@ Vec3 vertex_normal(const TriangleMesh& mesh, uint32_t index) {
     return {n[0], n[1], n[2]};
 }
 
-}  // namespace
-
 /// Embree's own allocations, counted as they happen (--stats reports the peak: the BVH and
 /// its build's scratch memory).
 struct MemoryCount {
@@ -174,6 +172,8 @@ bool count_embree_memory(void* user, ssize_t bytes, bool /*post*/) {
     }
     return true;  // never refuse: the limit is the machine's
 }
+
+}  // namespace
 
 struct Accelerator::Impl {
     const Scene& scene;

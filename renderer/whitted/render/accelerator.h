@@ -27,6 +27,10 @@ public:
     Accelerator(const Accelerator&) = delete;
     Accelerator& operator=(const Accelerator&) = delete;
 
+    /// Bytes Embree holds now (the BVH), and the most it held while building.
+    size_t embree_bytes() const;
+    size_t peak_embree_bytes() const;
+
     /// Nearest hit with ray.t_min < t < ray.t_max.
     bool intersect(const Ray& ray, SurfaceHit& hit) const;
     /// Whether anything lies strictly between ray.t_min and ray.t_max (shadow rays).
@@ -37,10 +41,6 @@ public:
     /// occluded() gives for that ray alone, up to Embree's float choice between two triangles
     /// meeting at an edge.
     static constexpr int packet_size = 16;
-
-    /// Bytes Embree holds now (the BVH), and the most it held while building.
-    size_t embree_bytes() const;
-    size_t peak_embree_bytes() const;
     void intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found) const;
     void occluded_packet(const Ray* rays, const bool* active, int count, bool* blocked) const;
 
