@@ -18,7 +18,7 @@ public:
     DisplayTransform(const std::string& config_path, const std::string& display, const std::string& view);
     ~DisplayTransform();
 
-    /// In place, `pixel_count` packed RGB float pixels.
+    /// In place, `pixel_count` packed RGB float pixels; large buffers on all cores.
     void apply(float* rgb, size_t pixel_count) const;
 
     /// Where the config came from ("built-in", a path, or "$OCIO=path"), and what was picked.

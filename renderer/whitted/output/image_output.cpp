@@ -15,7 +15,6 @@
 #include <OpenEXR/ImfThreading.h>
 
 #include <fcntl.h>
-#include <tbb/parallel_for.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -170,13 +169,7 @@ void write_image(const Image& image, const std::string& path, const OutputOption
             write_png(temporary.path(), image, display, bits, metadata);
         } else {
             std::vector<float> pixels = image.rgb;
-            // OCIO's CPU processor may be applied from several threads at once: bands of rows.
-            constexpr size_t band = 32;
-            const size_t width = size_t(image.width);
-            tbb::parallel_for(size_t(0), (size_t(image.height) + band - 1) / band, [&](size_t b) {
-                const size_t first = b * band, rows = std::min(band, size_t(image.height) - first);
-                display.apply(pixels.data() + 3 * width * first, width * rows);
-            });
+            display.apply(pixels.data(), pixels.size() / 3);
             const auto write =
                 reinterpret_cast<WriteDisplayImage>(image_io_plugin_symbol("whitted_write_display_image"));
             const std::string error =

@@ -146,8 +146,8 @@ void write_png(const std::string& path, const Image& linear, const DisplayTransf
     // In double, the product and the half are exact, so every value rounds to its nearest code
     // (in float, 0.7f * 255 + 0.5f came out 179, not 178).
     const double scale = bits == 16 ? 65535.0 : 255.0;
-    // Bands of rows on all cores (OCIO's CPU processor may be applied from several threads at
-    // once), each through a small buffer rather than a display-referred copy of the whole image.
+    // Bands of rows on all cores, each through a small buffer (one chunk for the display
+    // transform) rather than a display-referred copy of the whole image.
     constexpr int band = 8;
     tbb::parallel_for(0, (height + band - 1) / band, [&](int b) {
         const int first = b * band, count = std::min(band, height - first);
