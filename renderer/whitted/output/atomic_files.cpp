@@ -2,6 +2,7 @@
 #include "whitted/output/atomic_files.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -20,12 +21,6 @@ struct Pending {
     std::string temporary;  ///< empty while the file is unnamed
 };
 
-std::string temporary_name(const std::filesystem::path& target) {
-    const std::filesystem::path directory = target.parent_path().empty() ? "." : target.parent_path();
-    return (directory / ("." + target.filename().string() + ".whitted-" + std::to_string(::getpid()) + ".tmp"))
-        .string();
-}
-
 [[noreturn]] void fail(const std::filesystem::path& target, const std::string& what) {
     throw std::runtime_error("cannot write '" + target.string() + "': " + what + ": " + std::strerror(errno));
 }
@@ -35,7 +30,7 @@ void open_file(Pending& file) {
     file.fd = ::open(directory.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0644);
     if (file.fd >= 0) return;
     // No unnamed files here (an older kernel, or a filesystem such as NFS): a named one.
-    file.temporary = temporary_name(file.target);
+    file.temporary = temporary_path(file.target);
     file.fd = ::open(file.temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (file.fd < 0) {
         file.temporary.clear();
@@ -55,7 +50,7 @@ void write_all(const Pending& file, std::string_view bytes) {
 /// Gives an unnamed file its temporary name.
 void name_file(Pending& file) {
     if (!file.temporary.empty()) return;
-    const std::string name = temporary_name(file.target);
+    const std::string name = temporary_path(file.target);
     const std::string self = "/proc/self/fd/" + std::to_string(file.fd);
     if (::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, name.c_str(), AT_SYMLINK_FOLLOW) != 0 &&
         ::linkat(file.fd, "", AT_FDCWD, name.c_str(), AT_EMPTY_PATH) != 0)
@@ -64,6 +59,29 @@ void name_file(Pending& file) {
 }
 
 }  // namespace
+
+std::string temporary_path(const std::filesystem::path& target) {
+    const std::filesystem::path directory = target.parent_path().empty() ? "." : target.parent_path();
+    return (directory / ("." + target.filename().string() + ".whitted-" + std::to_string(::getpid()) + ".tmp" +
+                         target.extension().string()))
+        .string();
+}
+
+void move_into_place(const std::string& temporary, const std::filesystem::path& target) {
+    // An existing file is swapped out atomically (RENAME_EXCHANGE) and then deleted under the
+    // temporary name: a rename over it made ext4 start writing the new file to disk before
+    // returning (its "auto_da_alloc" for replace-by-rename), 10 ms for a 1280x960 float EXR
+    // against under 1 ms this way. Anything but a regular file there (nothing, a link, a
+    // directory), or a filesystem that cannot exchange: a plain rename, with its refusals.
+    struct stat existing {};
+    if (::lstat(target.c_str(), &existing) == 0 && S_ISREG(existing.st_mode) &&
+        ::renameat2(AT_FDCWD, temporary.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) == 0) {
+        std::remove(temporary.c_str());  // the old file
+        return;
+    }
+    if (std::rename(temporary.c_str(), target.c_str()) != 0)
+        throw std::runtime_error("cannot move the finished file to '" + target.string() + "': " + std::strerror(errno));
+}
 
 void write_files_atomically(const std::vector<std::pair<std::filesystem::path, std::string_view>>& files) {
     std::vector<Pending> pending(files.size());
@@ -80,8 +98,7 @@ void write_files_atomically(const std::vector<std::pair<std::filesystem::path, s
             if (::close(fd) != 0 && errno != EINTR) fail(file.target, "write failed");  // e.g. NFS quota
         }
         for (Pending& file : pending) {
-            if (std::rename(file.temporary.c_str(), file.target.c_str()) != 0)
-                fail(file.target, "cannot move the finished file into place");
+            move_into_place(file.temporary, file.target);
             file.temporary.clear();
         }
     } catch (...) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -11,10 +12,18 @@ namespace whitted {
 /// Writes each (path, bytes) so that the files appear complete or not at all. The bytes go to
 /// unnamed files in the targets' directories (O_TMPFILE), which vanish with the process if it
 /// is interrupted or killed; only when every file is written are they given their names (a
-/// link to `.NAME.whitted-PID.tmp`, then a rename over NAME). Where a filesystem cannot make
+/// link to temporary_path(NAME), then move_into_place). Where a filesystem cannot make
 /// unnamed files, the named temporary is written directly (and removed on failure; a kill can
 /// leave it). Throws std::runtime_error naming the file and the reason. Nothing is renamed
 /// before every file is written; the renames come last, one after the other.
+/// `.NAME.whitted-PID.tmp.EXT` beside `target`: where a file is finished before it is moved to
+/// `target` (hidden, and marked as ours, by process).
+std::string temporary_path(const std::filesystem::path& target);
+
+/// Moves a finished file to `target` in one step: an existing regular file is swapped out
+/// atomically and then deleted, anything else renamed over. Throws std::runtime_error.
+void move_into_place(const std::string& temporary, const std::filesystem::path& target);
+
 void write_files_atomically(const std::vector<std::pair<std::filesystem::path, std::string_view>>& files);
 
 }  // namespace whitted

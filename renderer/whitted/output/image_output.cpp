@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "whitted/output/image_output.h"
 
+#include "whitted/output/atomic_files.h"
 #include "whitted/output/color_management.h"
 
 #include "whitted/output/plugin.h"
@@ -14,7 +15,6 @@
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfThreading.h>
 
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -34,33 +34,16 @@ std::string lower_extension(const std::string& path) {
     return ext;
 }
 
-/// Removes the temporary file unless it was handed over by rename.
+/// Removes the temporary file unless it was moved into place.
 class TemporaryFile {
 public:
-    explicit TemporaryFile(const std::string& target) {
-        const std::filesystem::path t(target);
-        const std::filesystem::path dir = t.parent_path().empty() ? "." : t.parent_path();
-        m_path = (dir / ("." + t.filename().string() + ".whitted-" + std::to_string(::getpid()) + ".tmp" +
-                         t.extension().string()))
-                     .string();
-    }
+    explicit TemporaryFile(const std::string& target) : m_path(temporary_path(target)) {}
     ~TemporaryFile() {
         if (!m_committed) std::remove(m_path.c_str());
     }
     const std::string& path() const { return m_path; }
     void commit(const std::string& target) {
-        // An existing image is swapped out atomically (RENAME_EXCHANGE) and then deleted under
-        // the temporary name: a rename over it made ext4 start writing the new file to disk
-        // before returning (its "auto_da_alloc" for replace-by-rename), 10 ms for a 1280x960
-        // float EXR against under 1 ms this way. Without an old image (or where the filesystem
-        // cannot exchange), a plain rename.
-        if (::renameat2(AT_FDCWD, m_path.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) == 0) {
-            m_committed = true;
-            std::remove(m_path.c_str());  // the old image
-            return;
-        }
-        if (std::rename(m_path.c_str(), target.c_str()) != 0)
-            throw std::runtime_error("cannot move the finished image to '" + target + "': " + std::strerror(errno));
+        move_into_place(m_path, target);
         m_committed = true;
     }
 
