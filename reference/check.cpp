@@ -6,6 +6,7 @@
 
 #include "converters/pov_writer.h"
 #include "reference/povray.h"
+#include "whitted/output/atomic_files.h"
 #include "whitted/render/accelerator.h"
 #include "whitted/render/renderer.h"
 #include "whitted/scene/description.h"
@@ -16,7 +17,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <optional>
 #include <stdexcept>
 
@@ -55,13 +55,6 @@ Image scaled(const Image& image, double factor) {
     if (factor != 1)
         for (float& v : out.rgb) v = float(double(v) * factor);
     return out;
-}
-
-void write_text(const fs::path& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-    out.close();
-    if (!out) throw std::runtime_error("cannot write '" + path.string() + "'");
 }
 
 /// Whether POV-Ray's 16-bit PNG clipped a value that is not 1 in our image: a code of 65535
@@ -164,8 +157,9 @@ CheckResult run_check(const std::string& scene_path, const CheckOptions& options
         pov::ConvertOptions convert;
         convert.exposure = exposure;
         convert.hdr_output = false;
-        write_text(work / pov_name, pov::scene_to_sdl(description, convert));
-        write_text(work / ini_name, pov::ini_for(description, pov_name, povray_image_name, convert));
+        const std::string sdl = pov::scene_to_sdl(description, convert);
+        const std::string ini = pov::ini_for(description, pov_name, povray_image_name, convert);
+        write_files_atomically({{work / pov_name, sdl}, {work / ini_name, ini}});
         std::error_code ignored;
         fs::remove(work / povray_image_name, ignored);  // never read a previous run's image
 

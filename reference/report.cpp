@@ -5,6 +5,7 @@
 
 #include "reference/check.h"
 
+#include "whitted/output/atomic_files.h"
 #include "whitted/output/image_output.h"
 
 #include <OpenImageIO/imageio.h>
@@ -14,7 +15,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <stdexcept>
 
@@ -284,13 +284,6 @@ code { font-size: .95em; }
     return h;
 }
 
-void write_text(const fs::path& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-    out.close();
-    if (!out) throw std::runtime_error("cannot write '" + path.string() + "'");
-}
-
 }  // namespace
 
 void write_report(const std::string& dir, const std::string& scene_path, const Image& ours, const Image& theirs,
@@ -321,8 +314,9 @@ void write_report(const std::string& dir, const std::string& scene_path, const I
     }
     write_raw_png(heat, difference.width, difference.height, d / "diff.png");
 
-    write_text(d / "metrics.json", metrics_json(scene_path, result, options).dump(2) + "\n");
-    write_text(d / "report.html", report_html(dir, scene_path, result, options));
+    const std::string metrics = metrics_json(scene_path, result, options).dump(2) + "\n";
+    const std::string html = report_html(dir, scene_path, result, options);
+    write_files_atomically({{d / "metrics.json", metrics}, {d / "report.html", html}});
 }
 
 }  // namespace whitted::reference
