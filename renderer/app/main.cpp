@@ -221,10 +221,11 @@ int run_render(const RenderArguments& args) {
                 stderr,
                 "whitted: stages: parse %.3fs, validate+load %.3fs, build BVH %.3fs, render %.3fs, write %.3fs; "
                 "%zu triangles, %zu spheres, %zu boxes, %zu planes, %zu lights; BVH %.1f MB (%.1f MB while "
-                "building)\n",
+                "building); Embree %s, %d-wide packets\n",
                 parse_seconds, validate_seconds, build_seconds, result.seconds, write_seconds, scene.triangle_count(),
                 scene.spheres.size(), scene.boxes.size(), scene.planes.size(), scene.lights.size(),
-                double(accelerator.embree_bytes()) / 1e6, double(accelerator.peak_embree_bytes()) / 1e6);
+                double(accelerator.embree_bytes()) / 1e6, double(accelerator.peak_embree_bytes()) / 1e6,
+                accelerator.isa().empty() ? "(its choice)" : accelerator.isa().c_str(), accelerator.lane_width());
         if (!args.quiet)
             std::fprintf(stderr,
                          "whitted: %dx%d, %d sample(s)/pixel, %u thread(s): render %.3fs (total %.3fs), %.2f M rays "
@@ -297,6 +298,36 @@ int run_compare_command(const std::string& first, const std::string& second, dou
     }
 }
 
+/// `whitted --version`: the program's version and, since it decides which of Embree's code
+/// paths run, the instruction sets Embree can use here and the one in use.
+std::string version_text() {
+    std::string text = "whitted 0.1.0";
+    try {
+        const std::string isa = embree_isa_from_environment();
+        const EmbreeInfo info = embree_info(isa);
+        std::string isas;
+        for (const std::string& name : info.isas) isas += (isas.empty() ? "" : " ") + name;
+        text += "\nEmbree " + info.version + "; instruction sets this CPU can run: " + isas;
+        text += "\nin use: " + info.isa_in_use + (isa.empty() ? " (the widest)" : " (WHITTED_EMBREE_ISA)") + ", " +
+                std::to_string(info.lane_width) + "-wide packets";
+    } catch (const std::exception& e) {
+        text += "\nEmbree: " + std::string(e.what());
+    }
+    return text;
+}
+
+/// WHITTED_EMBREE_ISA, checked before any work: a name Embree does not know, or an instruction
+/// set this CPU lacks, is a usage error (exit 2), not a failure after parsing and loading.
+bool embree_isa_usable() {
+    try {
+        require_embree_isa(embree_isa_from_environment());
+        return true;
+    } catch (const std::exception& e) {
+        print_error(e.what());
+        return false;
+    }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -310,11 +341,14 @@ int main(int argc, char** argv) {
         "  L = ka*Ia + sum_i [kd*I_i*max(0,n.l_i) + ks*I_i*max(0,n.h_i)^p] + km*L(r)\n"
         "checked pixel by pixel against POV-Ray 3.7.",
         "whitted"};
-    app.set_version_flag("--version", std::string("whitted ") + "0.1.0");
+    app.set_version_flag("--version", version_text);
     app.require_subcommand(1);
     app.footer(
         "Exit status: 0 success; 1 failure while rendering or checking (or images disagree);\n"
         "2 bad input or usage; 130/143 interrupted by SIGINT/SIGTERM.\n"
+        "Environment: OCIO (colour config), WHITTED_POVRAY (POV-Ray for check),\n"
+        "WHITTED_EMBREE_ISA=sse2|sse4.2|avx|avx2|avx512 (force Embree's instruction set; the\n"
+        "image is the same bit for bit, only the speed differs; --version lists this CPU's).\n"
         "Scene format: docs/scene-format.md. Examples: examples/lecture/.");
 
     RenderArguments render_args;
@@ -393,6 +427,7 @@ int main(int argc, char** argv) {
         return code == 0 ? 0 : exit_bad_input;
     }
 
+    if ((*render_cmd || *check_cmd) && !embree_isa_usable()) return exit_bad_input;
     if (*render_cmd) {
         const int code = run_render(render_args);
         // The image is on disk and the summary printed: skip tearing down the BVH, the image

@@ -186,5 +186,33 @@ TEST(Triangle, MissesOutsideEdgesAndWhenParallel) {
     EXPECT_NEAR(hit.t, 1.0, 1e-12);
 }
 
+// The fallback for a float hit just over an edge: the plane's distance, whatever the edges and
+// the range say, and the barycentrics pulled back onto the triangle.
+TEST(Triangle, PlaneHitClampsBarycentricsOntoTheTriangle) {
+    const Vec3 v0{0, 0, 0}, v1{1, 0, 0}, v2{0, 1, 0};
+    ShapeHit hit;
+    // Outside the edge u + v = 1, at (0.75, 0.5): u = 0.75, v = 0.5 scaled to sum 1.
+    ASSERT_TRUE(hit_triangle_plane(v0, v1, v2, ray_from({0.75, 0.5, 2}, {0, 0, -1}), hit));
+    EXPECT_NEAR(hit.t, 2.0, 1e-12);
+    EXPECT_NEAR(hit.u, 0.6, 1e-12);
+    EXPECT_NEAR(hit.v, 0.4, 1e-12);
+    expect_vec_near(hit.normal, {0, 0, 1}, 1e-12);
+    // Beyond the edge v = 0 (v = -0.25): v becomes 0, u stays.
+    ASSERT_TRUE(hit_triangle_plane(v0, v1, v2, ray_from({0.5, -0.25, 3}, {0, 0, -1}), hit));
+    EXPECT_NEAR(hit.t, 3.0, 1e-12);
+    EXPECT_NEAR(hit.u, 0.5, 1e-12);
+    EXPECT_EQ(hit.v, 0.0);
+    // Inside, it agrees with intersect_triangle.
+    ShapeHit exact;
+    const Ray inside = ray_from({0.2, 0.3, -1}, {0.1, 0, 1});
+    ASSERT_TRUE(intersect_triangle(v0, v1, v2, inside, t_min, t_max, exact));
+    ASSERT_TRUE(hit_triangle_plane(v0, v1, v2, inside, hit));
+    EXPECT_EQ(hit.t, exact.t);
+    EXPECT_EQ(hit.u, exact.u);
+    EXPECT_EQ(hit.v, exact.v);
+    // Parallel to the plane: no answer.
+    EXPECT_FALSE(hit_triangle_plane(v0, v1, v2, ray_from({0.2, 0.2, 1}, {1, 0, 0}), hit));
+}
+
 }  // namespace
 }  // namespace whitted

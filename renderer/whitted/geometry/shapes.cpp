@@ -132,6 +132,30 @@ bool intersect_triangle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Ra
     return true;
 }
 
+bool hit_triangle_plane(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Ray& ray, ShapeHit& hit) {
+    // The same quantities as intersect_triangle, without its edge and distance tests.
+    const Vec3 e1 = v1 - v0, e2 = v2 - v0;
+    const Vec3 p = cross(ray.direction, e2);
+    const double det = dot(e1, p);
+    if (det == 0 || !std::isfinite(det)) return false;
+    const double inv_det = 1.0 / det;
+    const Vec3 s = ray.origin - v0;
+    const Vec3 q = cross(s, e1);
+    const double t = dot(e2, q) * inv_det;
+    if (!std::isfinite(t)) return false;
+    double u = std::max(0.0, dot(s, p) * inv_det), v = std::max(0.0, dot(ray.direction, q) * inv_det);
+    if (u + v > 1) {
+        const double sum = u + v;
+        u /= sum;
+        v /= sum;
+    }
+    hit.t = t;
+    hit.u = u;
+    hit.v = v;
+    hit.normal = cross(e1, e2);
+    return true;
+}
+
 void world_bounds(const Sphere& sphere, Vec3& lo, Vec3& hi) {
     bounds_of_transformed_box(sphere.object_to_world, sphere.center - Vec3(sphere.radius),
                               sphere.center + Vec3(sphere.radius), lo, hi);

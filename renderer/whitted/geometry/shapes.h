@@ -22,6 +22,11 @@ bool intersect_plane(const Plane& plane, const Ray& ray, double t_min, double t_
 /// Möller–Trumbore; the normal is (v1 − v0) × (v2 − v0).
 bool intersect_triangle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Ray& ray, double t_min, double t_max,
                         ShapeHit& hit);
+/// Where the ray's line meets the triangle's plane, with the barycentric weights clamped onto
+/// the triangle (so the shading normal is interpolated from inside it), whatever t is: for a
+/// hit that a float test found just over an edge that the double test rejects. False only when
+/// the ray is parallel to the plane (or the triangle is degenerate).
+bool hit_triangle_plane(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Ray& ray, ShapeHit& hit);
 
 /// World-space bounds of a sphere or box (its object-space box pushed through the transform).
 void world_bounds(const Sphere& sphere, Vec3& lo, Vec3& hi);

@@ -9,7 +9,9 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -24,13 +26,23 @@ enum class ShapeKind : uint32_t { triangles, spheres, boxes };
 /// into `rays`), so spheres and boxes never see the float copies.
 struct QueryContext {
     /// `coherent`: the rays are neighbours (a packet), which Embree can traverse together.
-    QueryContext(const Ray* query_rays, bool coherent) : rays(query_rays) {
+    /// Of the `count` rays, those with `active[i]` are queries (all of them if `active` is
+    /// null); the others may be stale memory.
+    QueryContext(const Ray* query_rays, const bool* active_rays, int ray_count, bool coherent)
+        : rays(query_rays), active(active_rays), count(ray_count) {
         rtcInitIntersectContext(&embree);
         if (coherent) embree.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     }
 
+    /// Whether Embree's lane with ray `id` is one of the queries. Embree hands a callback no
+    /// empty lane (set_empty_lane gives it no extent), but a callback must not read a stale ray
+    /// if some instruction set's code ever did.
+    bool is_query(unsigned id) const { return id < unsigned(count) && (!active || active[id]); }
+
     RTCIntersectContext embree;
     const Ray* rays = nullptr;
+    const bool* active = nullptr;
+    int count = 0;
     /// Nearest analytic hit so far per ray (double), set by intersect queries before tracing,
     /// and its normal, so it is not computed twice (set with it).
     double best_t[Accelerator::packet_size];
@@ -75,6 +87,7 @@ void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
     for (unsigned i = 0; i < args->N; ++i) {
         if (!args->valid[i]) continue;
         const unsigned id = RTCRayN_id(rays, args->N, i);
+        if (!context->is_query(id)) continue;
         const double limit = std::min(context->best_t[id], double(RTCRayN_tfar(rays, args->N, i)));
         ShapeHit hit;
         if (!intersect_analytic(*geometry, args->primID, context->rays[id], limit, hit)) continue;
@@ -98,21 +111,38 @@ void analytic_occluded(const RTCOccludedFunctionNArguments* args) {
     const auto* context = reinterpret_cast<const QueryContext*>(args->context);
     for (unsigned i = 0; i < args->N; ++i) {
         if (!args->valid[i]) continue;
-        const Ray& ray = context->rays[RTCRayN_id(args->ray, args->N, i)];
+        const unsigned id = RTCRayN_id(args->ray, args->N, i);
+        if (!context->is_query(id)) continue;
+        const Ray& ray = context->rays[id];
         ShapeHit hit;
         if (intersect_analytic(*geometry, args->primID, ray, ray.t_max, hit))
             RTCRayN_tfar(args->ray, args->N, i) = -INFINITY;  // Embree's mark for "occluded"
     }
 }
 
-/// Embree calls this from C code, where an exception must not pass: keep the first message
-/// and throw after the Embree call returns (check_embree).
+/// The first error Embree reported. Embree calls record_embree_error from C code, where an
+/// exception must not pass, and from any render thread: it keeps the message, and the caller
+/// throws it once the Embree call has returned (throw_if_failed).
+struct EmbreeError {
+    std::atomic<bool> failed{false};
+    mutable std::mutex mutex;
+    std::string message;
+
+    void throw_if_failed(const char* during) const {
+        if (!failed.load(std::memory_order_relaxed)) return;
+        std::lock_guard lock(mutex);
+        throw std::runtime_error(message + " (" + during + ")");
+    }
+};
+
 void record_embree_error(void* user, RTCError code, const char* message) {
-    auto* first_error = static_cast<std::string*>(user);
-    if (code != RTC_ERROR_NONE && first_error->empty())
-        *first_error = code == RTC_ERROR_OUT_OF_MEMORY
-                           ? "out of memory while building the BVH"
-                           : std::string("Embree: ") + (message ? message : "unknown error");
+    if (code == RTC_ERROR_NONE) return;
+    auto* error = static_cast<EmbreeError*>(user);
+    std::lock_guard lock(error->mutex);
+    if (error->failed.load()) return;
+    error->message = code == RTC_ERROR_OUT_OF_MEMORY ? std::string("Embree ran out of memory")
+                                                     : std::string("Embree: ") + (message ? message : "unknown error");
+    error->failed.store(true);
 }
 
 RTCRay make_embree_ray(const Ray& ray, unsigned id) {
@@ -132,8 +162,10 @@ RTCRay make_embree_ray(const Ray& ray, unsigned id) {
     return r;
 }
 
-/// Lane i of a 16-wide Embree packet; `id` = i, so callbacks find the double ray again.
-void set_lane(RTCRay16& packet, int i, const Ray& ray) {
+/// Lane i of an Embree packet (RTCRay4/8/16) holds `ray`; `id` is the ray's index in the
+/// query, so callbacks find the double ray again.
+template <class RayPacket>
+void set_lane(RayPacket& packet, int i, const Ray& ray, unsigned id) {
     packet.org_x[i] = float(ray.origin.x);
     packet.org_y[i] = float(ray.origin.y);
     packet.org_z[i] = float(ray.origin.z);
@@ -144,8 +176,82 @@ void set_lane(RTCRay16& packet, int i, const Ray& ray) {
     packet.tfar[i] = float(ray.t_max);
     packet.time[i] = 0;
     packet.mask[i] = 0xFFFFFFFFu;
-    packet.id[i] = unsigned(i);
+    packet.id[i] = id;
     packet.flags[i] = 0;
+}
+
+/// A lane with no query in it. Embree's native packet code skips it by its `valid` mask, but
+/// where Embree has no native code for the width (rtcIntersect16 without AVX-512) its ray
+/// stream filter ignores the mask and traces every lane: so the lane holds a well-formed ray
+/// that cannot hit anything, the form Embree itself gives unused lanes (tnear 0, tfar -inf).
+template <class RayPacket>
+void set_empty_lane(RayPacket& packet, int i, unsigned id) {
+    packet.org_x[i] = packet.org_y[i] = packet.org_z[i] = 0;
+    packet.dir_x[i] = packet.dir_y[i] = 0;
+    packet.dir_z[i] = 1;
+    packet.tnear[i] = 0;
+    packet.tfar[i] = -INFINITY;
+    packet.time[i] = 0;
+    packet.mask[i] = 0;
+    packet.id[i] = id;
+    packet.flags[i] = 0;
+}
+
+/// Embree's packet types and calls for W lanes, so that one piece of code serves every width.
+template <int W>
+struct EmbreePacket;
+template <>
+struct EmbreePacket<4> {
+    using RayHit = RTCRayHit4;
+    using Rays = RTCRay4;
+    static void intersect(const int* valid, RTCScene scene, RTCIntersectContext* context, RayHit* rays) {
+        rtcIntersect4(valid, scene, context, rays);
+    }
+    static void occluded(const int* valid, RTCScene scene, RTCIntersectContext* context, Rays* rays) {
+        rtcOccluded4(valid, scene, context, rays);
+    }
+};
+template <>
+struct EmbreePacket<8> {
+    using RayHit = RTCRayHit8;
+    using Rays = RTCRay8;
+    static void intersect(const int* valid, RTCScene scene, RTCIntersectContext* context, RayHit* rays) {
+        rtcIntersect8(valid, scene, context, rays);
+    }
+    static void occluded(const int* valid, RTCScene scene, RTCIntersectContext* context, Rays* rays) {
+        rtcOccluded8(valid, scene, context, rays);
+    }
+};
+template <>
+struct EmbreePacket<16> {
+    using RayHit = RTCRayHit16;
+    using Rays = RTCRay16;
+    static void intersect(const int* valid, RTCScene scene, RTCIntersectContext* context, RayHit* rays) {
+        rtcIntersect16(valid, scene, context, rays);
+    }
+    static void occluded(const int* valid, RTCScene scene, RTCIntersectContext* context, Rays* rays) {
+        rtcOccluded16(valid, scene, context, rays);
+    }
+};
+
+std::string isa_list() {
+    std::string list;
+    for (const std::string& name : embree_isa_names()) list += (list.empty() ? "" : ", ") + name;
+    return list;
+}
+
+/// An Embree device with the render's thread count and, unless `isa` is empty, that instruction
+/// set. Throws std::invalid_argument when the CPU cannot run `isa`.
+RTCDevice make_device(const std::string& config_start, const std::string& isa) {
+    std::string config = config_start;
+    if (!isa.empty()) config += ",isa=" + isa;
+    RTCDevice device = rtcNewDevice(config.c_str());
+    if (device) return device;
+    const RTCError code = rtcGetDeviceError(nullptr);
+    if (code == RTC_ERROR_UNSUPPORTED_CPU && !isa.empty())
+        throw std::invalid_argument("WHITTED_EMBREE_ISA=" + isa + ": this CPU cannot run Embree's " + isa +
+                                    " code (unset it to let Embree choose)");
+    throw std::runtime_error("cannot create the Embree device (Embree error " + std::to_string(int(code)) + ")");
 }
 
 Vec3 vertex(const TriangleMesh& mesh, uint32_t index) {
@@ -173,11 +279,65 @@ bool count_embree_memory(void* user, ssize_t bytes, bool /*post*/) {
     return true;  // never refuse: the limit is the machine's
 }
 
+/// The widest packet Embree traverses natively with the device's instruction set. A wider call
+/// than that goes through Embree's ray stream filter, which repacks the rays on every call: on
+/// an AVX2 CPU, 16-wide calls traced torus100k at about half the rays/s of 8-wide ones
+/// (docs/performance.md). The width changes only the grouping: each ray's answer is recomputed
+/// in double, so the pixels are the same for every width.
+int native_lane_width(RTCDevice device) {
+    if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED)) return 16;
+    if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED)) return 8;
+    if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED)) return 4;
+    return 1;
+}
+
 }  // namespace
+
+const std::vector<std::string>& embree_isa_names() {
+    static const std::vector<std::string> names = {"sse2", "sse4.2", "avx", "avx2", "avx512"};
+    return names;
+}
+
+std::string embree_isa_from_environment() {
+    const char* value = std::getenv("WHITTED_EMBREE_ISA");
+    if (!value || !*value) return "";
+    const std::vector<std::string>& names = embree_isa_names();
+    if (std::find(names.begin(), names.end(), value) == names.end())
+        throw std::invalid_argument(std::string("WHITTED_EMBREE_ISA=") + value +
+                                    ": not one of Embree's instruction sets (" + isa_list() +
+                                    "); unset it to let Embree choose");
+    return value;
+}
+
+void require_embree_isa(const std::string& isa) {
+    rtcReleaseDevice(make_device("verbose=0", isa));
+}
+
+bool embree_isa_supported(const std::string& isa) {
+    try {
+        require_embree_isa(isa);
+        return true;
+    } catch (const std::invalid_argument&) {
+        return false;
+    }
+}
+
+EmbreeInfo embree_info(const std::string& isa) {
+    EmbreeInfo info;
+    info.version = RTC_VERSION_STRING;
+    for (const std::string& name : embree_isa_names())
+        if (embree_isa_supported(name)) info.isas.push_back(name);
+    info.isa_in_use = !isa.empty() ? isa : info.isas.empty() ? std::string("?") : info.isas.back();
+    RTCDevice device = make_device("verbose=0", isa);
+    info.lane_width = native_lane_width(device);
+    rtcReleaseDevice(device);
+    return info;
+}
 
 struct Accelerator::Impl {
     const Scene& scene;
-    std::string embree_error;  ///< first error Embree reported (see record_embree_error)
+    std::string isa;
+    EmbreeError embree_error;  ///< see record_embree_error
     MemoryCount memory;
     RTCDevice device = nullptr;
     RTCScene rtc_scene = nullptr;
@@ -187,15 +347,15 @@ struct Accelerator::Impl {
     AnalyticGeometry spheres{ShapeKind::spheres, nullptr};
     AnalyticGeometry boxes{ShapeKind::boxes, nullptr};
     RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;  ///< of the scene and its meshes (build_quality)
+    int lane_width = 1;                                  ///< rays per Embree packet call (native_lane_width)
 
-    Impl(const Scene& s, int threads) : scene(s) {
+    Impl(const Scene& s, int threads, const std::string& instruction_set) : scene(s), isa(instruction_set) {
         spheres.scene = boxes.scene = &scene;
         // Embree gets the render's thread count (--threads): its setting limits the whole
         // process's TBB threads (with threads=1 the render ran at half speed), so the two must
         // agree.
-        const std::string config = "verbose=0,threads=" + std::to_string(threads);
-        device = rtcNewDevice(config.c_str());
-        if (!device) throw std::runtime_error("cannot create the Embree device");
+        device = make_device("verbose=0,threads=" + std::to_string(threads), isa);
+        lane_width = native_lane_width(device);
         rtcSetDeviceErrorFunction(device, record_embree_error, &embree_error);
         rtcSetDeviceMemoryMonitorFunction(device, count_embree_memory, &memory);
         rtc_scene = rtcNewScene(device);
@@ -205,9 +365,11 @@ struct Accelerator::Impl {
         if (!scene.spheres.empty()) add_analytic(spheres, scene.spheres.size());
         if (!scene.boxes.empty()) add_analytic(boxes, scene.boxes.size());
         rtcCommitScene(rtc_scene);
-        if (!embree_error.empty()) {
+        try {
+            embree_error.throw_if_failed("while building the BVH");
+        } catch (...) {
             release();
-            throw std::runtime_error(embree_error);
+            throw;
         }
     }
 
@@ -293,9 +455,13 @@ struct Accelerator::Impl {
             if (kinds[geom] == ShapeKind::triangles) {
                 const TriangleMesh& mesh = scene.meshes[mesh_of_geometry[geom]];
                 const uint32_t* index = &mesh.indices[3 * size_t(prim)];
-                if (!intersect_triangle(vertex(mesh, index[0]), vertex(mesh, index[1]), vertex(mesh, index[2]), ray,
-                                        ray.t_min, ray.t_max, hit)) {
-                    // Float and double disagree on an edge: keep Embree's answer.
+                const Vec3 v0 = vertex(mesh, index[0]), v1 = vertex(mesh, index[1]), v2 = vertex(mesh, index[2]);
+                if (!intersect_triangle(v0, v1, v2, ray, ray.t_min, ray.t_max, hit) &&
+                    !hit_triangle_plane(v0, v1, v2, ray, hit)) {
+                    // Float and double disagree on an edge: the hit is taken where the double ray
+                    // meets the triangle's plane (hit_triangle_plane), not from Embree's float
+                    // numbers, which differ in the last bits from one instruction set to another.
+                    // Only a ray parallel to the plane in double is left with Embree's answer.
                     hit.t = t;
                     hit.u = u;
                     hit.v = v;
@@ -329,7 +495,7 @@ struct Accelerator::Impl {
     }
 
     bool intersect(const Ray& ray, SurfaceHit& out) const {
-        QueryContext context(&ray, false);
+        QueryContext context(&ray, nullptr, 1, false);
         context.best_t[0] = ray.t_max;
         RTCRayHit rayhit;
         rayhit.ray = make_embree_ray(ray, 0);
@@ -341,25 +507,59 @@ struct Accelerator::Impl {
                           context.best_normal[0], out);
     }
 
-    void intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found) const {
-        QueryContext context(rays, true);
-        alignas(64) int valid[packet_size];
-        alignas(64) RTCRayHit16 packet;
-        for (int i = 0; i < packet_size; ++i) {
-            valid[i] = (i < count && active[i]) ? -1 : 0;
-            if (!valid[i]) continue;  // Embree reads only the valid lanes
-            context.best_t[i] = rays[i].t_max;
-            set_lane(packet.ray, i, rays[i]);
-            packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-            packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    /// Rays [first, first + W) of a packet through Embree's W-wide call. Every lane is written:
+    /// a query, or an empty lane (set_empty_lane).
+    template <int W>
+    void intersect_lanes(QueryContext& context, const Ray* rays, const bool* query, int first, int count,
+                         SurfaceHit* hits, bool* found) const {
+        alignas(64) int valid[W];
+        alignas(64) typename EmbreePacket<W>::RayHit packet;
+        bool any = false;
+        for (int lane = 0; lane < W; ++lane) {
+            const int i = first + lane;
+            const bool is_query = i < count && query[i];
+            valid[lane] = is_query ? -1 : 0;
+            any |= is_query;
+            if (is_query) {
+                context.best_t[i] = rays[i].t_max;
+                set_lane(packet.ray, lane, rays[i], unsigned(i));
+            } else {
+                set_empty_lane(packet.ray, lane, unsigned(i));
+            }
+            packet.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
+            packet.hit.instID[0][lane] = RTC_INVALID_GEOMETRY_ID;
         }
-        rtcIntersect16(valid, rtc_scene, &context.embree, &packet);
-        for (int i = 0; i < count; ++i) {
-            if (!active[i]) continue;
-            found[i] = finish_hit(rays[i], packet.hit.geomID[i], packet.hit.primID[i], packet.hit.u[i], packet.hit.v[i],
-                                  packet.ray.tfar[i], {packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i]},
+        if (!any) return;
+        EmbreePacket<W>::intersect(valid, rtc_scene, &context.embree, &packet);
+        for (int lane = 0; lane < W; ++lane) {
+            const int i = first + lane;
+            if (!valid[lane]) continue;
+            found[i] = finish_hit(rays[i], packet.hit.geomID[lane], packet.hit.primID[lane], packet.hit.u[lane],
+                                  packet.hit.v[lane], packet.ray.tfar[lane],
+                                  {packet.hit.Ng_x[lane], packet.hit.Ng_y[lane], packet.hit.Ng_z[lane]},
                                   context.best_t[i], context.best_normal[i], hits[i]);
         }
+    }
+
+    void intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found) const {
+        QueryContext context(rays, active, count, true);
+        switch (lane_width) {
+            case 16:
+                intersect_lanes<16>(context, rays, active, 0, count, hits, found);
+                break;
+            case 8:
+                for (int first = 0; first < count; first += 8)
+                    intersect_lanes<8>(context, rays, active, first, count, hits, found);
+                break;
+            case 4:
+                for (int first = 0; first < count; first += 4)
+                    intersect_lanes<4>(context, rays, active, first, count, hits, found);
+                break;
+            default:
+                for (int i = 0; i < count; ++i)
+                    if (active[i]) found[i] = intersect(rays[i], hits[i]);
+        }
+        embree_error.throw_if_failed("while tracing rays");
     }
 
     bool occluded_by_plane(const Ray& ray) const {
@@ -372,33 +572,71 @@ struct Accelerator::Impl {
 
     bool occluded(const Ray& ray) const {
         if (occluded_by_plane(ray)) return true;
-        QueryContext context(&ray, false);
+        QueryContext context(&ray, nullptr, 1, false);
         RTCRay r = make_embree_ray(ray, 0);
         rtcOccluded1(rtc_scene, &context.embree, &r);
         return r.tfar < 0;
     }
 
-    void occluded_packet(const Ray* rays, const bool* active, int count, bool* blocked) const {
-        QueryContext context(rays, true);
-        alignas(64) int valid[packet_size];
-        alignas(64) RTCRay16 packet;
-        int remaining = 0;
-        for (int i = 0; i < packet_size; ++i) {
-            const bool query = i < count && active[i] && !(blocked[i] = occluded_by_plane(rays[i]));
-            valid[i] = query ? -1 : 0;
-            remaining += query;
-            if (query) set_lane(packet, i, rays[i]);  // Embree reads only the valid lanes
+    /// Shadow rays [first, first + W) through Embree's W-wide call; every lane is written.
+    template <int W>
+    void occluded_lanes(QueryContext& context, const Ray* rays, const bool* query, int first, int count,
+                        bool* blocked) const {
+        alignas(64) int valid[W];
+        alignas(64) typename EmbreePacket<W>::Rays packet;
+        bool any = false;
+        for (int lane = 0; lane < W; ++lane) {
+            const int i = first + lane;
+            const bool is_query = i < count && query[i];
+            valid[lane] = is_query ? -1 : 0;
+            any |= is_query;
+            if (is_query)
+                set_lane(packet, lane, rays[i], unsigned(i));
+            else
+                set_empty_lane(packet, lane, unsigned(i));
         }
-        if (remaining == 0) return;
-        rtcOccluded16(valid, rtc_scene, &context.embree, &packet);
-        for (int i = 0; i < count; ++i)
-            if (valid[i]) blocked[i] = packet.tfar[i] < 0;
+        if (!any) return;
+        EmbreePacket<W>::occluded(valid, rtc_scene, &context.embree, &packet);
+        for (int lane = 0; lane < W; ++lane)
+            if (valid[lane]) blocked[first + lane] = packet.tfar[lane] < 0;
+    }
+
+    void occluded_packet(const Ray* rays, const bool* active, int count, bool* blocked) const {
+        // Planes first (no BVH): a ray a plane blocks needs no Embree query.
+        bool query[packet_size];
+        for (int i = 0; i < count; ++i) query[i] = active[i] && !(blocked[i] = occluded_by_plane(rays[i]));
+        QueryContext context(rays, query, count, true);
+        switch (lane_width) {
+            case 16:
+                occluded_lanes<16>(context, rays, query, 0, count, blocked);
+                break;
+            case 8:
+                for (int first = 0; first < count; first += 8)
+                    occluded_lanes<8>(context, rays, query, first, count, blocked);
+                break;
+            case 4:
+                for (int first = 0; first < count; first += 4)
+                    occluded_lanes<4>(context, rays, query, first, count, blocked);
+                break;
+            default:
+                for (int i = 0; i < count; ++i)
+                    if (query[i]) blocked[i] = occluded(rays[i]);
+        }
+        embree_error.throw_if_failed("while tracing shadow rays");
     }
 };
 
 Accelerator::Accelerator(const Scene& scene, int threads)
-    : m_impl(std::make_unique<Impl>(scene,
-                                    threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency())))) {}
+    : Accelerator(scene, threads, embree_isa_from_environment()) {}
+Accelerator::Accelerator(const Scene& scene, int threads, const std::string& isa)
+    : m_impl(std::make_unique<Impl>(
+          scene, threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency())), isa)) {}
+int Accelerator::lane_width() const {
+    return m_impl->lane_width;
+}
+const std::string& Accelerator::isa() const {
+    return m_impl->isa;
+}
 Accelerator::~Accelerator() = default;
 size_t Accelerator::peak_embree_bytes() const {
     return size_t(std::max<int64_t>(0, m_impl->memory.peak.load()));

@@ -5,8 +5,31 @@
 #include "whitted/scene/scene.h"
 
 #include <memory>
+#include <string>
+#include <vector>
 
 namespace whitted {
+
+/// Embree's instruction sets, narrowest first, by the names of Embree's `isa=` setting. Embree
+/// picks the widest the CPU has; forcing a narrower one (WHITTED_EMBREE_ISA) lets the tests run,
+/// on one machine, the code paths that users' CPUs take (docs/building.md).
+const std::vector<std::string>& embree_isa_names();
+/// $WHITTED_EMBREE_ISA: "" when unset or empty (Embree chooses). Throws std::invalid_argument,
+/// naming the choices, when it is none of embree_isa_names().
+std::string embree_isa_from_environment();
+/// Throws std::invalid_argument, saying so, when Embree cannot run `isa` on this CPU ("" always
+/// can): an Embree device is made with it and released, so a bad setting is found before any work.
+void require_embree_isa(const std::string& isa);
+bool embree_isa_supported(const std::string& isa);
+
+/// What `whitted --version` reports of Embree.
+struct EmbreeInfo {
+    std::string version;            ///< e.g. "3.13.5"
+    std::vector<std::string> isas;  ///< of embree_isa_names(), those this CPU can run
+    std::string isa_in_use;         ///< the one asked for, else the widest of `isas`
+    int lane_width = 1;             ///< Accelerator::lane_width() with it
+};
+EmbreeInfo embree_info(const std::string& isa);
 
 /// What a ray hit, in double precision.
 struct SurfaceHit {
@@ -22,7 +45,11 @@ struct SurfaceHit {
 class Accelerator {
 public:
     /// `threads`: how many threads Embree may use to build (0 = all cores); pass the render's.
+    /// Embree's instruction set comes from $WHITTED_EMBREE_ISA (embree_isa_from_environment).
     explicit Accelerator(const Scene& scene, int threads = 0);
+    /// `isa`: one of embree_isa_names(), or "" for the widest the CPU has. Throws
+    /// std::invalid_argument when the CPU cannot run it.
+    Accelerator(const Scene& scene, int threads, const std::string& isa);
     ~Accelerator();
     Accelerator(const Accelerator&) = delete;
     Accelerator& operator=(const Accelerator&) = delete;
@@ -39,8 +66,15 @@ public:
     /// Up to packet_size rays at once, those with active[i]: Embree traces neighbouring (coherent)
     /// rays together much faster than one by one. Each answer is exactly what intersect() or
     /// occluded() gives for that ray alone, up to Embree's float choice between two triangles
-    /// meeting at an edge.
+    /// meeting at an edge. The rays go to Embree in groups of lane_width(); a lane that is not
+    /// active holds an empty ray, never stale memory, since only Embree's native packet code
+    /// honours its `valid` mask.
     static constexpr int packet_size = 16;
+    /// Rays per Embree call: the widest packet Embree traverses natively with the instruction
+    /// set in use (16 with AVX-512, 8 with AVX/AVX2, 4 with SSE), 1 if it has no packets.
+    int lane_width() const;
+    /// The instruction set asked for ("" = Embree's choice), as given to the constructor.
+    const std::string& isa() const;
     void intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found) const;
     void occluded_packet(const Ray* rays, const bool* active, int count, bool* blocked) const;
 

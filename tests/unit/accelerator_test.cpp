@@ -1,0 +1,205 @@
+// SPDX-License-Identifier: MIT
+// whitted::Accelerator under every Embree instruction set this CPU has: a packet query must give
+// each active ray exactly what the ray gets alone, leave the inactive lanes' outputs untouched,
+// for every packet size from 1 to 16 and every instruction set (4-, 8- and 16-wide Embree
+// packets); and WHITTED_EMBREE_ISA is checked by name.
+
+#include "whitted/render/accelerator.h"
+#include "whitted/scene/scene.h"
+
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+namespace whitted {
+namespace {
+
+// Every shape kind: a sphere and a box (Embree user geometry), a mesh and a triangle (Embree
+// triangles), a plane (tested apart from Embree).
+const std::string scene_text = test::join_lines({
+    "camera: {eye: [0, 1, 6], look_at: [0, 0, 0]}",
+    "image: {width: 8, height: 8}",
+    "materials:",
+    "  a: {kd: 0.5}",
+    "  b: {kd: 0.7}",
+    "objects:",
+    "  - {type: sphere, center: [-1, 0, 0], radius: 0.8, material: a}",
+    "  - {type: box, min: [0.4, -1, -0.5], max: [1.4, 0.2, 0.5], material: b}",
+    "  - {type: triangle, vertices: [[-2, -1, -2], [2, -1, -2], [0, 2, -2.5]], material: b}",
+    "  - {type: mesh, material: a, vertices: [[-0.5, 0.6, 0.5], [0.5, 0.6, 0.5], [0, 1.4, 0]],",
+    "     triangles: [[0, 1, 2]]}",
+    "  - {type: plane, point: [0, -1, 0], normal: [0, 1, 0], material: a}",
+});
+
+/// A fan of rays from the eye over the scene: ray k of n, spread over the image.
+Ray fan_ray(int k, int n) {
+    const double x = -0.5 + (k + 0.5) / n, y = 0.35 - 0.7 * ((k * 7) % n) / n;
+    const Vec3 direction = normalize(Vec3{x, y - 0.15, -1});
+    return {{0, 1, 6}, direction, 1e-3, 1e30};
+}
+
+/// A shadow ray from a point of the floor to a light above the scene.
+Ray shadow_ray(int k, int n) {
+    const Vec3 from{-2.5 + 5.0 * (k + 0.5) / n, -1, -1.5 + 3.0 * ((k * 5) % n) / n};
+    const Vec3 to{0.3, 4, 1};
+    const Vec3 d = to - from;
+    const double distance = length(d);
+    return {from, d / distance, 1e-3, distance - 1e-3};
+}
+
+TEST(EmbreeIsa, NamesAreEmbreesAndTheEnvironmentIsChecked) {
+    const std::vector<std::string> expected{"sse2", "sse4.2", "avx", "avx2", "avx512"};
+    EXPECT_EQ(embree_isa_names(), expected);
+    ::unsetenv("WHITTED_EMBREE_ISA");
+    EXPECT_EQ(embree_isa_from_environment(), "");
+    ::setenv("WHITTED_EMBREE_ISA", "avx2", 1);
+    EXPECT_EQ(embree_isa_from_environment(), "avx2");
+    ::setenv("WHITTED_EMBREE_ISA", "AVX3", 1);
+    try {
+        (void)embree_isa_from_environment();
+        ADD_FAILURE() << "an unknown name was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("WHITTED_EMBREE_ISA=AVX3: not one of Embree's instruction sets (sse2, "
+                                             "sse4.2, avx, avx2, avx512)"),
+                  std::string::npos)
+            << e.what();
+    }
+    ::unsetenv("WHITTED_EMBREE_ISA");
+}
+
+// Every x86-64 CPU has SSE2; the widest set the CPU has is the one Embree uses by itself.
+TEST(EmbreeIsa, InfoListsWhatThisCpuRuns) {
+    const EmbreeInfo info = embree_info("");
+    ASSERT_FALSE(info.isas.empty());
+    EXPECT_EQ(info.isas.front(), "sse2");
+    EXPECT_EQ(info.isa_in_use, info.isas.back());
+    EXPECT_TRUE(embree_isa_supported(""));
+    for (const std::string& isa : embree_isa_names()) {
+        const bool listed = std::find(info.isas.begin(), info.isas.end(), isa) != info.isas.end();
+        EXPECT_EQ(embree_isa_supported(isa), listed) << isa;
+        if (!listed) {
+            EXPECT_THROW(require_embree_isa(isa), std::invalid_argument) << isa;
+        }
+    }
+}
+
+/// Embree's native packet width for each instruction set (its device properties).
+int expected_lane_width(const std::string& isa) {
+    if (isa == "avx512") return 16;
+    if (isa == "avx" || isa == "avx2") return 8;
+    return 4;
+}
+
+class PacketsPerIsa : public testing::TestWithParam<std::string> {};
+
+TEST_P(PacketsPerIsa, EachRayGetsWhatItGetsAloneAndInactiveLanesAreUntouched) {
+    const std::string isa = GetParam();
+    if (!embree_isa_supported(isa)) GTEST_SKIP() << "this CPU cannot run Embree's " << isa << " code";
+    const Scene scene = test::scene_from(scene_text);
+    const Accelerator accelerator(scene, 1, isa);
+    EXPECT_EQ(accelerator.isa(), isa);
+    EXPECT_EQ(accelerator.lane_width(), expected_lane_width(isa));
+
+    constexpr int lanes = Accelerator::packet_size;
+    int hits_seen = 0, blocked_seen = 0, clear_seen = 0;
+    for (int count = 1; count <= lanes; ++count) {
+        for (int pattern = 0; pattern < 3; ++pattern) {
+            Ray rays[lanes], shadow_rays[lanes];
+            bool active[lanes];
+            for (int i = 0; i < lanes; ++i) {
+                rays[i] = fan_ray(i + count * lanes, lanes * (lanes + 1));
+                shadow_rays[i] = shadow_ray(i + count * lanes, lanes * (lanes + 1));
+                // All lanes; every third one off; only the last of the packet.
+                active[i] = pattern == 0 || (pattern == 1 && i % 3 != 1) || (pattern == 2 && i == count - 1);
+            }
+            SurfaceHit hits[lanes];
+            bool found[lanes], blocked[lanes];
+            const SurfaceHit sentinel{-7, {1, 2, 3}, {4, 5, 6}, 99};
+            for (int i = 0; i < lanes; ++i) hits[i] = sentinel, found[i] = true, blocked[i] = true;
+            accelerator.intersect_packet(rays, active, count, hits, found);
+            accelerator.occluded_packet(shadow_rays, active, count, blocked);
+            for (int i = 0; i < lanes; ++i) {
+                SCOPED_TRACE(isa + ", count " + std::to_string(count) + ", pattern " + std::to_string(pattern) +
+                             ", lane " + std::to_string(i));
+                if (i >= count || !active[i]) {
+                    EXPECT_TRUE(found[i]);
+                    EXPECT_EQ(hits[i].t, sentinel.t);
+                    EXPECT_EQ(hits[i].material, sentinel.material);
+                    if (i >= count) {
+                        EXPECT_TRUE(blocked[i]);
+                    }
+                    continue;
+                }
+                SurfaceHit alone;
+                const bool alone_found = accelerator.intersect(rays[i], alone);
+                ASSERT_EQ(found[i], alone_found);
+                if (alone_found) {
+                    ++hits_seen;
+                    EXPECT_EQ(hits[i].t, alone.t);
+                    EXPECT_EQ(hits[i].material, alone.material);
+                    EXPECT_EQ(hits[i].normal.x, alone.normal.x);
+                    EXPECT_EQ(hits[i].normal.y, alone.normal.y);
+                    EXPECT_EQ(hits[i].normal.z, alone.normal.z);
+                }
+                const bool alone_blocked = accelerator.occluded(shadow_rays[i]);
+                EXPECT_EQ(blocked[i], alone_blocked);
+                ++(alone_blocked ? blocked_seen : clear_seen);
+            }
+        }
+    }
+    // The rays must have met every kind of answer, or the comparison proves little.
+    EXPECT_GT(hits_seen, 100);
+    EXPECT_GT(blocked_seen, 20);
+    EXPECT_GT(clear_seen, 20);
+}
+
+// The same rays give bit-identical hits under every instruction set: each hit is recomputed in
+// double from the double ray, so Embree's float arithmetic (with or without FMA) does not show.
+TEST(PacketsAcrossIsas, HitsAreBitIdentical) {
+    const Scene scene = test::scene_from(scene_text);
+    const EmbreeInfo info = embree_info("");
+    ASSERT_GE(info.isas.size(), 1u);
+    constexpr int lanes = Accelerator::packet_size, packets = 40;
+    std::vector<SurfaceHit> first(lanes * packets);
+    std::vector<char> first_found(lanes * packets);
+    for (size_t n = 0; n < info.isas.size(); ++n) {
+        const Accelerator accelerator(scene, 1, info.isas[n]);
+        for (int p = 0; p < packets; ++p) {
+            Ray rays[lanes];
+            bool active[lanes], found[lanes] = {};
+            SurfaceHit hits[lanes];
+            for (int i = 0; i < lanes; ++i) rays[i] = fan_ray(p * lanes + i, lanes * packets), active[i] = true;
+            accelerator.intersect_packet(rays, active, lanes, hits, found);
+            for (int i = 0; i < lanes; ++i) {
+                const int k = p * lanes + i;
+                if (n == 0) {
+                    first[k] = hits[i], first_found[k] = found[i];
+                    continue;
+                }
+                ASSERT_EQ(bool(first_found[k]), found[i]) << info.isas[n] << " ray " << k;
+                if (!found[i]) continue;
+                EXPECT_EQ(hits[i].t, first[k].t) << info.isas[n] << " ray " << k;
+                EXPECT_EQ(hits[i].normal.x, first[k].normal.x) << info.isas[n] << " ray " << k;
+                EXPECT_EQ(hits[i].normal.y, first[k].normal.y) << info.isas[n] << " ray " << k;
+                EXPECT_EQ(hits[i].normal.z, first[k].normal.z) << info.isas[n] << " ray " << k;
+                EXPECT_EQ(hits[i].material, first[k].material) << info.isas[n] << " ray " << k;
+            }
+        }
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryIsa, PacketsPerIsa, testing::ValuesIn(embree_isa_names()),
+                         [](const testing::TestParamInfo<std::string>& param) {
+                             std::string name = param.param;
+                             for (char& c : name)
+                                 if (c == '.') c = '_';
+                             return name;
+                         });
+
+}  // namespace
+}  // namespace whitted
