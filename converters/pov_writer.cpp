@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Scene format v1 → POV-Ray 3.7 SDL, following pov-model.md: a right-handed camera through
+// Scene format v1 → POV-Ray 3.7 SDL, following docs/pov-model.md: a right-handed camera through
 // `right -x·W/H`, lights without falloff, `parallel` lights at Whitted's directional distance,
 // max_trace_level = max_depth with adc_bailout 0, and the lecture's material either as one
 // texture (recipe A, where exact) or as four layers (recipe B, exact for any RGB ka, kd, ks).
@@ -60,7 +60,7 @@ bool is_grey(const Color& c) {
 }
 
 /// The highlight statement for a finish: Blinn-Phong is `specular s roughness 1/p`, Phong is
-/// `phong s phong_size p` (pov-model.md §2).
+/// `phong s phong_size p` (docs/pov-model.md §2).
 std::string highlight(Highlight kind, double strength, double p) {
     if (strength == 0) return "specular 0 phong 0";
     if (kind == Highlight::phong) return "specular 0 phong " + num(strength) + " phong_size " + num(p);
@@ -73,7 +73,7 @@ std::string mirror(const Color& km) {
 
 /// The lecture's material as POV-Ray texture(s).
 std::string texture(const Material& m) {
-    // Recipe A (pov-model.md §1a): one texture. POV multiplies ambient and diffuse by the
+    // Recipe A (docs/pov-model.md §1a): one texture. POV multiplies ambient and diffuse by the
     // pigment, not the highlight, so it is exact when ks is grey and kd_c > 0 wherever ka_c > 0.
     bool single_texture_exact = is_grey(m.ks);
     for (int c = 0; c < 3; ++c) single_texture_exact &= !(m.ka[c] > 0 && m.kd[c] == 0);
@@ -87,7 +87,7 @@ std::string texture(const Material& m) {
         return "texture { pigment { " + rgb(m.kd) + " } finish { ambient " + rgb(ambient_ratio) +
                " diffuse 1 brilliance 1 " + highlight(m.highlight, m.ks.x, m.p) + mirror(m.km) + " } }";
     }
-    // Recipe B (pov-model.md §1b): four layers, bottom first, with t1 = t2 = 1/2 and s = 1:
+    // Recipe B (docs/pov-model.md §1b): four layers, bottom first, with t1 = t2 = 1/2 and s = 1:
     //   L4 opaque black, holds the highlight lobe (never tinted by its own pigment);
     //   L3 a pure filter ks/(t1·t2) that tints L4's highlight to exactly ks;
     //   L2 kd/(t1·(1 − t2)) at transmit t2: the diffuse term;
@@ -282,7 +282,7 @@ static std::string write_sdl(const SceneDescription& d, const ConvertOptions& op
 
     const CameraDescription& c = d.camera;
     if (c.type.value == CameraType::perspective) {
-        // `right -x·W/H` makes POV-Ray's camera right-handed (pov-model.md §4); `angle` is the horizontal fov.
+        // `right -x·W/H` makes POV-Ray's camera right-handed (docs/pov-model.md §4); `angle` is the horizontal fov.
         o += "camera {\n  perspective\n  location " + vec(c.eye.value) + "\n  right <" + num(-aspect) +
              ", 0, 0>\n  up <0, 1, 0>\n  sky " + vec(c.up.value) + "\n  angle " + num(c.fov.value) + "\n  look_at " +
              vec(c.look_at.value) + "\n}\n";

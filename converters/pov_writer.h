@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
-// Scene format v1 → POV-Ray 3.7 SDL that renders the same image (pov-model.md). Reads the
+// Scene format v1 → POV-Ray 3.7 SDL that renders the same image (docs/pov-model.md). Reads the
 // plain SceneDescription, never the render objects, like any other consumer of the format.
 
 #include "whitted/scene/description.h"

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The verification numbers of pov-model.md: §6 (a sphere, optionally over a glazed plane,
+// The verification numbers of docs/pov-model.md: §6 (a sphere, optionally over a glazed plane,
 // whose pixels POV-Ray 3.7 reproduced to 1/65535) and §2.2 (two facing mirrors give
 // 0.2·(1 − 0.5^N) at max_depth N). The §6 scene is written in POV-Ray's left-handed numbers;
 // in Whitted's right-handed format x is mirrored, so the light moves from (−5, 5, −5) to (5, 5, −5).

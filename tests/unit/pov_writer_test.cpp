@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The POV-Ray converter (pov-model.md §1): numbers are written so that POV-Ray reads back the
+// The POV-Ray converter (docs/pov-model.md §1): numbers are written so that POV-Ray reads back the
 // very doubles Whitted uses, nothing from the scene except numbers reaches the SDL, and the
 // lecture's material becomes recipe A (one texture, grey ks) or recipe B (four layered textures).
 
@@ -120,7 +120,7 @@ TEST(PovWriter, RecipeAForGreySpecular) {
     EXPECT_THAT(sdl, HasSubstr("adc_bailout 0"));
 }
 
-// Coloured ks: four layers, bottom first (pov-model §1b with t1 = t2 = 1/2, s = 1):
+// Coloured ks: four layers, bottom first (docs/pov-model.md §1b with t1 = t2 = 1/2, s = 1):
 // black + specular lobe; filter ks/(t1·t2); diffuse kd/(t1·(1 − t2)) at transmit t2; white at
 // transmit t1 with ambient ka/(1 − t1) and the mirror.
 TEST(PovWriter, RecipeBLayersForColouredSpecular) {
@@ -161,7 +161,7 @@ TEST(PovWriter, TintedSpecularAloneSelectsRecipeB) {
     EXPECT_EQ(numbers_after(sdl, "rgbf", 4), (std::vector<double>{0.5 / 0.25, 0.5 / 0.25, 0.25 / 0.25, 1}));
 }
 
-// The .ini renders deterministically and linearly (pov-model §0): size, no display, no
+// The .ini renders deterministically and linearly (docs/pov-model.md §0): size, no display, no
 // antialiasing, 16-bit linear PNG.
 TEST(PovWriter, IniIsLinearAndDeterministic) {
     const SceneDescription d = parse_scene_text(

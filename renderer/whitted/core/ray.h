@@ -15,7 +15,7 @@ struct Ray {
     Vec3 at(double t) const { return origin + direction * t; }
 };
 
-/// Self-intersection and range rules shared with POV-Ray 3.7 (pov-model.md §3), so that both
+/// Self-intersection and range rules shared with POV-Ray 3.7 (docs/pov-model.md §3), so that both
 /// renderers decide the same hits: no origin offset, only minimum distances.
 namespace ray_limits {
 /// Camera and reflected rays ignore hits closer than this (POV-Ray's MIN_ISECT_DEPTH).

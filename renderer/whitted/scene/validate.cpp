@@ -286,7 +286,7 @@ Camera make_camera(const CameraDescription& d, int width, int height) {
     const Vec3 side = cross(forward, d.up.value);
     if (length(side) <= 1e-9 * length(d.up.value))
         fail(d.up.where, "camera.up is parallel to the view direction (eye → look_at); pick another up");
-    // The same construction as POV-Ray's camera with `right -x*W/H`, `sky up` (pov-model.md §4):
+    // The same construction as POV-Ray's camera with `right -x*W/H`, `sky up` (docs/pov-model.md §4):
     // screen right = normalize(forward × up), screen up = forward × normalize(up × forward).
     const Vec3 right_unit = normalize(side);
     const Vec3 up_unit = cross(forward, normalize(cross(d.up.value, forward)));
