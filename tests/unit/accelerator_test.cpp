@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -191,6 +192,59 @@ TEST(PacketsAcrossIsas, HitsAreBitIdentical) {
             }
         }
     }
+}
+
+// Random rays, from anywhere in and around the scene (inside the sphere and the box too) in any
+// direction, with random minimum distances, in randomly filled packets: the packet answer is
+// the single-ray answer, bit for bit, under each instruction set.
+TEST_P(PacketsPerIsa, RandomRaysGetTheSingleRayAnswer) {
+    const std::string isa = GetParam();
+    if (!embree_isa_supported(isa)) GTEST_SKIP() << "this CPU cannot run Embree's " << isa << " code";
+    const Scene scene = test::scene_from(scene_text);
+    const Accelerator accelerator(scene, 2, isa);
+    std::mt19937_64 random(20261201);
+    std::uniform_real_distribution<double> coordinate(-3, 3), unit(-1, 1), chance(0, 1);
+    constexpr int lanes = Accelerator::packet_size;
+    int hits_seen = 0, misses_seen = 0, blocked_seen = 0;
+    for (int packet = 0; packet < 400; ++packet) {
+        Ray rays[lanes];
+        bool active[lanes];
+        const int count = 1 + int(chance(random) * lanes) % lanes;
+        for (int i = 0; i < lanes; ++i) {
+            Vec3 direction;
+            do direction = {unit(random), unit(random), unit(random)};
+            while (length(direction) < 0.1);
+            const double t_min = chance(random) < 0.5 ? 1e-4 : 1e-3;
+            const double t_max = chance(random) < 0.5 ? 1e7 : 0.5 + 5 * chance(random);
+            rays[i] = {
+                {coordinate(random), coordinate(random), coordinate(random)}, normalize(direction), t_min, t_max};
+            active[i] = chance(random) < 0.8;
+        }
+        SurfaceHit hits[lanes];
+        bool found[lanes] = {}, blocked[lanes] = {};
+        accelerator.intersect_packet(rays, active, count, hits, found);
+        accelerator.occluded_packet(rays, active, count, blocked);
+        for (int i = 0; i < count; ++i) {
+            if (!active[i]) continue;
+            SurfaceHit alone;
+            const bool alone_found = accelerator.intersect(rays[i], alone);
+            ASSERT_EQ(found[i], alone_found) << isa << " packet " << packet << " lane " << i;
+            ++(alone_found ? hits_seen : misses_seen);
+            if (alone_found) {
+                EXPECT_EQ(hits[i].t, alone.t) << isa << " packet " << packet << " lane " << i;
+                EXPECT_EQ(hits[i].material, alone.material);
+                EXPECT_EQ(hits[i].normal.x, alone.normal.x);
+                EXPECT_EQ(hits[i].normal.y, alone.normal.y);
+                EXPECT_EQ(hits[i].normal.z, alone.normal.z);
+            }
+            const bool alone_blocked = accelerator.occluded(rays[i]);
+            EXPECT_EQ(blocked[i], alone_blocked) << isa << " packet " << packet << " lane " << i;
+            blocked_seen += alone_blocked;
+        }
+    }
+    EXPECT_GT(hits_seen, 500);
+    EXPECT_GT(misses_seen, 100);
+    EXPECT_GT(blocked_seen, 500);
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryIsa, PacketsPerIsa, testing::ValuesIn(embree_isa_names()),
