@@ -257,6 +257,19 @@ int run_convert(const std::string& scene_path, const std::string& output) {
         if (ext != ".pov")
             throw std::invalid_argument("cannot convert to '" + output + "': unknown format '" + ext +
                                         "'; supported: .pov (POV-Ray 3.7)");
+        // Usage errors before any work: where the two files cannot go. (write_pov_files refuses a
+        // directory in the way too, before it replaces anything, for one that appears meanwhile.)
+        std::filesystem::path ini_path(output);
+        ini_path.replace_extension(".ini");
+        for (const std::filesystem::path& target : {std::filesystem::path(output), ini_path}) {
+            const std::filesystem::path dir = target.parent_path().empty() ? "." : target.parent_path();
+            std::error_code error;
+            if (!std::filesystem::is_directory(dir, error))
+                throw std::invalid_argument("cannot write '" + target.string() + "': directory '" + dir.string() +
+                                            "' does not exist");
+            if (std::filesystem::is_directory(target, error))
+                throw std::invalid_argument("cannot write '" + target.string() + "': it is a directory");
+        }
         const SceneDescription description = parse_scene_file(scene_path);
         validate_scene(description);  // refuse what Whitted itself would refuse
         const std::string ini = pov::write_pov_files(description, output);
