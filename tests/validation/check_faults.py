@@ -9,7 +9,8 @@
             stand-in POV-Ray (fake_povray.py) hangs, once more with one that ignores both
             signals: whitted exits 143/130 within 5 s, POV-Ray is no longer running, and
             $TMPDIR (private to the test) holds no whitted-check-* or whitted-povray-home-*.
-Usage: check_faults.py WHITTED symlinks SCENE [--povray POVRAY] | signals"""
+  povray-signals  the same with the real POV-Ray, on a scene it takes many seconds to render.
+Usage: check_faults.py WHITTED symlinks SCENE [--povray POVRAY] | signals | povray-signals"""
 
 import argparse
 import os
@@ -130,6 +131,90 @@ def interrupt(whitted, d, mode, sig, to_group):
     return problems
 
 
+# Whitted renders this in about a second; POV-Ray, at 4x4 samples (3200x2400 pixels), mirrors
+# and 40 spheres, for well over ten.
+BIG_SCENE = """version: 1
+camera: { eye: [0, 3, 9], look_at: [0, 0.5, 0], fov: 55 }
+image: { width: 800, height: 600, samples: 4, background: [0.1, 0.1, 0.15] }
+render: { max_depth: 6 }
+lights:
+  - { type: point, position: [-5, 8, 6], intensity: 0.5 }
+  - { type: point, position: [5, 6, 4], intensity: 0.3 }
+materials:
+  mirror: { ka: 0.02, kd: 0.2, ks: 0.3, p: 60, km: 0.4 }
+objects:
+  - { type: plane, point: [0, 0, 0], normal: [0, 1, 0], material: mirror }
+""" + "".join(f"  - {{ type: sphere, center: [{x}, 0.6, {z}], radius: 0.5, material: mirror }}\n"
+              for x in range(-4, 5) for z in range(-4, 1))
+
+
+def children(pid):
+    found = []
+    for task in os.listdir(f"/proc/{pid}/task"):
+        try:
+            with open(f"/proc/{pid}/task/{task}/children") as f:
+                found += [int(c) for c in f.read().split()]
+        except FileNotFoundError:
+            pass
+    return found
+
+
+def povray_interrupt(whitted, d, sig, to_group):
+    tmp = os.path.join(d, f"tmp-povray-{sig.name}")
+    os.mkdir(tmp)
+    scene = os.path.join(d, "big.yaml")
+    name = f"real POV-Ray, {sig.name} to {'the process group' if to_group else 'whitted'}"
+    process = subprocess.Popen([whitted, "check", scene, "-q"], env=dict(os.environ, TMPDIR=tmp),
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    povray, started = None, time.monotonic()
+    while povray is None and time.monotonic() - started < 60 and process.poll() is None:
+        time.sleep(0.05)
+        found = children(process.pid) if process.poll() is None else []
+        povray = found[0] if found else None
+    if povray is None:
+        process.kill()
+        out, err = process.communicate()
+        return [f"{name}: POV-Ray never started ({out!r} {err!r})"]
+    time.sleep(1.0)  # well into POV-Ray's render
+    if process.poll() is not None:
+        return [f"{name}: the check ended before the signal (exit {process.returncode}): scene too small"]
+    sent = time.monotonic()
+    if to_group:
+        os.killpg(process.pid, sig)
+    else:
+        process.send_signal(sig)
+    problems = []
+    try:
+        _, err = process.communicate(timeout=10)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        _, err = process.communicate()
+        problems.append(f"{name}: whitted still running 10 s after the signal")
+    took = time.monotonic() - sent
+    if process.returncode != 128 + sig.value:
+        problems.append(f"{name}: exit {process.returncode}, expected {128 + sig.value} ({err.strip()!r})")
+    if took > 5:
+        problems.append(f"{name}: took {took:.1f} s to stop (limit 5 s)")
+    if running(povray):
+        os.kill(povray, signal.SIGKILL)
+        problems.append(f"{name}: POV-Ray (pid {povray}) still running after whitted ended")
+    leftovers = sorted(os.listdir(tmp))
+    if leftovers:
+        problems.append(f"{name}: temporary directories left in $TMPDIR: {leftovers}")
+    print(f"{name}: exit {process.returncode} in {took:.2f} s, {leftovers} left" + ("" if problems else ", ok"))
+    return problems
+
+
+def povray_signals(whitted):
+    problems = []
+    with tempfile.TemporaryDirectory(prefix="whitted-check-povray-signals-") as d:
+        with open(os.path.join(d, "big.yaml"), "w") as f:
+            f.write(BIG_SCENE)
+        problems += povray_interrupt(whitted, d, signal.SIGTERM, to_group=False)
+        problems += povray_interrupt(whitted, d, signal.SIGINT, to_group=True)
+    return problems
+
+
 def signals(whitted):
     problems = []
     with tempfile.TemporaryDirectory(prefix="whitted-check-signals-") as d:
@@ -146,11 +231,16 @@ def signals(whitted):
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("whitted")
-    parser.add_argument("what", choices=["symlinks", "signals"])
+    parser.add_argument("what", choices=["symlinks", "signals", "povray-signals"])
     parser.add_argument("scene", nargs="?")
     parser.add_argument("--povray")
     args = parser.parse_args()
-    problems = symlinks(args.whitted, args.scene, args.povray) if args.what == "symlinks" else signals(args.whitted)
+    if args.what == "symlinks":
+        problems = symlinks(args.whitted, args.scene, args.povray)
+    elif args.what == "signals":
+        problems = signals(args.whitted)
+    else:
+        problems = povray_signals(args.whitted)
     for problem in problems:
         print("FAIL " + problem)
     sys.exit(1 if problems else 0)
