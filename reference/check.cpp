@@ -82,34 +82,46 @@ std::string rgb_codes(const float* v) {
 
 void print_table(const std::string& scene_path, const CheckResult& r, const CheckOptions& options) {
     const ImageComparison& c = r.comparison;
+    const PassRule& rule = options.rule;
     std::string out;
     out +=
         fmt::format("whitted check {}: {}x{}, {} sample(s)/pixel, compared at exposure {:g}{}\n", scene_path, c.width,
                     c.height, r.samples * r.samples, r.exposure, r.exposure != 1 ? " (scene values above 1)" : "");
     out += fmt::format("  Whitted {:.3f}s, POV-Ray {:.2f}s ({} run{}, {})\n", r.whitted_seconds, r.povray_seconds,
                        r.povray_runs, r.povray_runs == 1 ? "" : "s", r.povray_program);
-    out += fmt::format("  max error    {:.3e}  ({} codes of 65535)\n", c.max_error, format_codes(c.max_error));
+    out += fmt::format("  max error    {:.3e}  ({} codes of 65535; cap {:g})\n", c.max_error, format_codes(c.max_error),
+                       rule.max_error * 65535);
     out +=
         fmt::format("  mean error   {:.3e}  ({} codes)\n", c.mean_error, fmt::format("{:.3f}", c.mean_error * 65535));
     out += fmt::format("  RMS error    {:.3e}  ({} codes)\n", c.rms_error, fmt::format("{:.3f}", c.rms_error * 65535));
     out += std::isinf(c.psnr) ? std::string("  PSNR         inf (identical)\n")
                               : fmt::format("  PSNR         {:.1f} dB (peak 1)\n", c.psnr);
-    out += fmt::format("  within {:g}/65535: {} ({} of {} pixels; {:g}% required)\n", options.tolerance * 65535,
-                       format_percent(c), c.pixels_within, c.pixels, options.required_fraction * 100);
-    out += fmt::format("  worst pixel  ({}, {}): Whitted {}  POV-Ray {}\n", c.worst_x, c.worst_y,
-                       rgb_text(c.worst_ours), rgb_text(c.worst_theirs));
-    out += fmt::format("               in codes: Whitted {}  POV-Ray {}\n", rgb_codes(c.worst_ours),
-                       rgb_codes(c.worst_theirs));
+    out += fmt::format("  within {:g}/65535: {} ({} of {} pixels; {:g}% required)\n", rule.tolerance * 65535,
+                       format_percent(c), c.pixels_within, c.pixels, rule.required_fraction * 100);
+    if (c.nonfinite_ours + c.nonfinite_theirs > 0)
+        out += fmt::format("  NaN/Inf      {} value(s) in Whitted's image, {} in POV-Ray's\n", c.nonfinite_ours,
+                           c.nonfinite_theirs);
+    if (!c.worst.empty()) {
+        const PixelError& w = c.worst.front();
+        out += fmt::format("  worst pixel  ({}, {}): Whitted {}  POV-Ray {}\n", w.x, w.y, rgb_text(w.ours),
+                           rgb_text(w.theirs));
+        out += fmt::format("               in codes: Whitted {}  POV-Ray {}\n", rgb_codes(w.ours), rgb_codes(w.theirs));
+    }
     if (!options.report_dir.empty())
         out += "  report       " + (fs::path(options.report_dir) / "report.html").string() + "\n";
     std::fputs(out.c_str(), stdout);
 }
 
+void throw_if_cancelled(const CheckOptions& options) {
+    if (options.cancel && options.cancel->load()) throw Interrupted();
+}
+
 }  // namespace
 
 std::string verdict_line(const std::string& scene_path, const CheckResult& r, const CheckOptions& options) {
-    return fmt::format("{} {}: {} of pixels within {:g}/65535 (max {} codes)", r.passed ? "PASS" : "FAIL", scene_path,
-                       format_percent(r.comparison), options.tolerance * 65535, format_codes(r.comparison.max_error));
+    // No figures when the images could not be compared at all (their sizes differ).
+    const bool compared = r.comparison.pixels > 0;
+    return verdict_text(scene_path, compared ? verdict_figures(r.comparison, options.rule) : std::string(), r.failures);
 }
 
 CheckResult run_check(const std::string& scene_path, const CheckOptions& options) {
@@ -129,6 +141,11 @@ CheckResult run_check(const std::string& scene_path, const CheckOptions& options
     }
     result.samples = scene.samples;
     const int n = scene.samples;
+
+    // From here on there are directories and files to remove or finish: a signal only asks
+    // for the check to stop (POV-Ray ended, temporaries removed), it no longer exits at once.
+    if (options.exit_at_once) options.exit_at_once->store(false);
+    throw_if_cancelled(options);
 
     // 2. Where POV-Ray's files go: the report directory (kept), else a temporary one.
     std::optional<TemporaryDirectory> temporary;
@@ -163,8 +180,9 @@ CheckResult run_check(const std::string& scene_path, const CheckOptions& options
         std::error_code ignored;
         fs::remove(work / povray_image_name, ignored);  // never read a previous run's image
 
-        const PovrayRun run = run_povray((work / ini_name).string(),
-                                         options.report_dir.empty() ? std::string() : (work / "povray.log").string());
+        const PovrayRun run =
+            run_povray((work / ini_name).string(),
+                       options.report_dir.empty() ? std::string() : (work / "povray.log").string(), options.cancel);
         result.povray_program = run.program;
         result.povray_seconds += run.seconds;
         ++result.povray_runs;
@@ -172,23 +190,30 @@ CheckResult run_check(const std::string& scene_path, const CheckOptions& options
             throw std::runtime_error("POV-Ray finished but wrote no '" + (work / povray_image_name).string() +
                                      "'; its last words:\n" +
                                      run.log.substr(run.log.size() > 2000 ? run.log.size() - 2000 : 0));
+        // The size and channels rules: POV-Ray must have written RGB at n·W × n·H. Anything
+        // else is a failed comparison, reported as such, not an error of the check.
+        const ImageShape shape = read_image_shape((work / povray_image_name).string());
+        result.failures = shape_mismatches({ours.width * n, ours.height * n, 3}, shape);
         theirs_full = read_linear_image((work / povray_image_name).string());
-        if (theirs_full.width != ours.width * n || theirs_full.height != ours.height * n)
-            throw std::runtime_error(fmt::format("POV-Ray wrote a {}x{} image; expected {}x{}", theirs_full.width,
-                                                 theirs_full.height, ours.width * n, ours.height * n));
-        if (attempt == max_exposure_retries || !povray_clipped(theirs_full, ours, n, exposure, options.tolerance))
+        if (!result.failures.empty()) break;
+        if (attempt == max_exposure_retries || !povray_clipped(theirs_full, ours, n, exposure, options.rule.tolerance))
             break;
         exposure *= 0.5;
     }
     result.exposure = exposure;
 
     // 4. The comparison, at the exposure POV-Ray rendered with.
-    const Image theirs = downsample_box(theirs_full, n);
     const Image ours_exposed = scaled(ours, exposure);
-    result.comparison = compare_images(ours_exposed, theirs, options.tolerance);
-    result.passed = result.comparison.fraction_within() >= options.required_fraction;
+    Image theirs = theirs_full;
+    if (result.failures.empty()) {
+        theirs = downsample_box(theirs_full, n);
+        result.comparison = compare_images(ours_exposed, theirs, options.rule.tolerance, options.worst_count);
+        result.failures = failed_rules(result.comparison, options.rule, "Whitted's image", "POV-Ray's");
+    }
+    result.passed = result.failures.empty();
+    throw_if_cancelled(options);
 
-    if (!options.quiet) print_table(scene_path, result, options);
+    if (!options.quiet && result.comparison.pixels > 0) print_table(scene_path, result, options);
     if (!options.report_dir.empty())
         write_report(options.report_dir, scene_path, ours_exposed, theirs, result, options);
     std::printf("%s\n", verdict_line(scene_path, result, options).c_str());

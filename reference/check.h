@@ -3,23 +3,38 @@
 
 #include "compare.h"
 
+#include <atomic>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace whitted::reference {
 
+/// Thrown when a check is cancelled (a signal): POV-Ray has been stopped, and the temporary
+/// directories go with the unwinding.
+struct Interrupted : std::runtime_error {
+    Interrupted() : std::runtime_error("interrupted") {}
+};
+
 struct CheckOptions {
-    std::string report_dir;            ///< empty: no report
-    double tolerance = 2.0 / 65535.0;  ///< per channel, absolute, linear
-    double required_fraction = 0.999;  ///< share of pixels that must be within tolerance
+    std::string report_dir;  ///< empty: no report
+    PassRule rule;
+    size_t worst_count = 10;  ///< pixels listed by the report
     int threads = 0;
     bool quiet = false;
+    /// Set (by a signal handler) to stop: POV-Ray is ended and run_check throws Interrupted.
+    const std::atomic<bool>* cancel = nullptr;
+    /// While true a signal may end the program at once, since nothing exists to clean up yet;
+    /// run_check sets it to false before it creates its first directory or file.
+    std::atomic<bool>* exit_at_once = nullptr;
 };
 
 struct CheckResult {
     ImageComparison comparison;
     double exposure = 1;  ///< the scale both images were compared at (< 1 for scenes brighter than 1)
     bool passed = false;
-    int samples = 1;  ///< image.samples: POV-Ray rendered samples×W by samples×H
+    std::vector<std::string> failures;  ///< the rules broken (failed_rules, shape_mismatches)
+    int samples = 1;                    ///< image.samples: POV-Ray rendered samples×W by samples×H
     double whitted_seconds = 0, povray_seconds = 0;
     int povray_runs = 0;                           ///< more than 1 when POV-Ray clipped and was run again darker
     std::string povray_program;                    ///< the povray that ran
@@ -38,7 +53,8 @@ void write_report(const std::string& dir, const std::string& scene_path, const I
                   const CheckResult& result, const CheckOptions& options);
 
 /// The one-line verdict printed last by `whitted check` (scripts/validate reads it), e.g.
-/// "PASS scene.yaml: 100.000% of pixels within 2/65535 (max 1.0 codes)".
+/// "PASS scene.yaml: 100.000% of pixels within 2/65535 (99.9% required), max 1.0 codes (cap 64)",
+/// or with "; failed: cap (max 1000.0 codes > 64)" and the like for each rule broken.
 std::string verdict_line(const std::string& scene_path, const CheckResult& result, const CheckOptions& options);
 
 }  // namespace whitted::reference

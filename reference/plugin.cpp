@@ -9,6 +9,9 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <string>
 #include <utility>
@@ -32,44 +35,70 @@ __attribute__((visibility("default"))) std::string whitted_write_display_image(
     return wrote && closed ? std::string() : out->geterror();
 }
 
-/// `whitted check`: returns the exit status (0 pass, 1 images differ, 2 cannot check) and
-/// prints its own messages.
+/// `whitted check`: returns the exit status (0 pass, 1 images differ, 2 cannot check, 128 +
+/// the signal when interrupted) and prints its own messages.
 __attribute__((visibility("default"))) int whitted_run_check(const std::string& scene_path,
-                                                             const whitted::reference::CheckOptions& options) {
+                                                             const whitted::reference::CheckOptions& options,
+                                                             const std::atomic<int>& signal) {
     try {
         return whitted::reference::run_check(scene_path, options).passed ? 0 : 1;
+    } catch (const whitted::reference::Interrupted&) {
+        std::fprintf(stderr, "whitted: interrupted; POV-Ray stopped, temporary files removed\n");
+        return 128 + (signal.load() ? signal.load() : SIGINT);
     } catch (const whitted::InputError& e) {
         std::fprintf(stderr, "whitted: error: %s\n", e.what());
         return 2;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "whitted: error: out of memory while checking %s\n", scene_path.c_str());
+        return 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "whitted: error: %s\n", e.what());
         return 2;
     }
 }
 
-/// `whitted compare A B`: per-channel comparison of two images of the same size; with `clip`
-/// both are first clipped to [0, 1] (to compare a float EXR with a PNG, which clips).
-/// Returns 0 when at least `required_fraction` of the pixels are within `tolerance`, else 1; 2
-/// when an image cannot be read or the sizes differ.
+/// `whitted compare A B`: per-channel comparison of two images under `rule` (the share, cap,
+/// finite, size and channels rules); with `clip` both are first clipped to [0, 1] (to compare
+/// a float EXR with a PNG, which clips), NaN/Inf values counted before that. Returns 0 when
+/// every rule holds, else 1; 2 when an image cannot be read.
 __attribute__((visibility("default"))) int whitted_run_compare(const std::string& first, const std::string& second,
-                                                               double tolerance, bool clip, double required_fraction) {
+                                                               const whitted::reference::PassRule& rule, bool clip) {
     using namespace whitted::reference;
     try {
-        whitted::Image a = read_linear_image(first), b = read_linear_image(second);
-        if (a.width != b.width || a.height != b.height) {
-            std::fprintf(stderr, "whitted: error: %s is %dx%d but %s is %dx%d\n", first.c_str(), a.width, a.height,
-                         second.c_str(), b.width, b.height);
-            return 2;
+        // Both headers first: an unreadable second file is found before the first is read.
+        const ImageShape shape_a = read_image_shape(first), shape_b = read_image_shape(second);
+        const std::string subject = first + " vs " + second;
+        std::vector<std::string> failures = shape_mismatches(shape_a, shape_b);
+        if (!failures.empty()) {
+            std::printf("%s\n", verdict_text(subject, "", failures).c_str());
+            return 1;
         }
-        if (clip)
-            for (auto* image : {&a, &b})
-                for (float& v : image->rgb) v = std::min(std::max(v, 0.0f), 1.0f);
-        const ImageComparison c = compare_images(a, b, tolerance);
-        const bool passed = c.fraction_within() >= required_fraction;
-        std::printf("%s %s vs %s: %s of pixels within %.3g/65535, max %.2f codes at (%d, %d), RMS %.3g\n",
-                    passed ? "PASS" : "FAIL", first.c_str(), second.c_str(), format_percent(c).c_str(),
-                    tolerance * 65535, c.max_error * 65535, c.worst_x, c.worst_y, c.rms_error);
-        return passed ? 0 : 1;
+        whitted::Image a = read_linear_image(first), b = read_linear_image(second);
+        size_t nonfinite[2] = {0, 0};
+        int index = 0;
+        for (auto* image : {&a, &b}) {
+            for (float& v : image->rgb) {
+                nonfinite[index] += !std::isfinite(v);
+                // Clipping would turn an Inf into 1: counted above, and kept NaN here.
+                if (clip && std::isfinite(v)) v = std::min(std::max(v, 0.0f), 1.0f);
+            }
+            ++index;
+        }
+        ImageComparison c = compare_images(a, b, rule.tolerance, 1);
+        c.nonfinite_ours = nonfinite[0];
+        c.nonfinite_theirs = nonfinite[1];
+        failures = failed_rules(c, rule, first, second);
+        std::string figures = verdict_figures(c, rule);
+        if (!c.worst.empty())
+            figures += " at (" + std::to_string(c.worst[0].x) + ", " + std::to_string(c.worst[0].y) + ")";
+        char rms[32];
+        std::snprintf(rms, sizeof rms, ", RMS %.3g", c.rms_error);
+        std::printf("%s\n", verdict_text(subject, figures + rms, failures).c_str());
+        return failures.empty() ? 0 : 1;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "whitted: error: out of memory while comparing %s and %s\n", first.c_str(),
+                     second.c_str());
+        return 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "whitted: error: %s\n", e.what());
         return 2;

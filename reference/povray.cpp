@@ -5,7 +5,11 @@
 
 #include "reference/povray.h"
 
+#include "reference/check.h"
+#include "whitted/output/atomic_files.h"
+
 #include <fcntl.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -19,6 +23,7 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 extern char** environ;
@@ -68,6 +73,30 @@ std::string last_lines(const std::string& text, int count) {
     return text.substr(start, end - start);
 }
 
+/// Waits for `pid` for at most `limit`; true once it is reaped.
+bool reap(pid_t pid, int& status, std::chrono::milliseconds limit) {
+    const auto until = std::chrono::steady_clock::now() + limit;
+    for (;;) {
+        const pid_t done = ::waitpid(pid, &status, WNOHANG);
+        if (done == pid) return true;
+        if (done < 0 && errno != EINTR)
+            throw std::runtime_error("lost track of POV-Ray: " + std::string(std::strerror(errno)));
+        if (std::chrono::steady_clock::now() >= until) return false;
+        // Polled rather than blocked in waitpid so that a cancel request is seen within 10 ms.
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+}
+
+/// Ends POV-Ray: SIGTERM lets it exit by itself, SIGKILL follows if it does not within 2 s.
+void stop(pid_t pid) {
+    int status = 0;
+    ::kill(pid, SIGTERM);
+    if (reap(pid, status, std::chrono::milliseconds(2000))) return;
+    ::kill(pid, SIGKILL);
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+}
+
 }  // namespace
 
 TemporaryDirectory::TemporaryDirectory(const std::string& prefix) {
@@ -104,7 +133,7 @@ std::string find_povray() {
     throw std::runtime_error("'" + name + "' was not found on PATH. " + install_hint);
 }
 
-PovrayRun run_povray(const std::string& ini_path, const std::string& log_path) {
+PovrayRun run_povray(const std::string& ini_path, const std::string& log_path, const std::atomic<bool>* cancel) {
     PovrayRun run;
     run.program = find_povray();
     const fs::path ini = fs::absolute(ini_path);
@@ -145,15 +174,18 @@ PovrayRun run_povray(const std::string& ini_path, const std::string& log_path) {
     if (const int error = ::posix_spawn(&pid, program.c_str(), actions.get(), nullptr, argv.data(), envp.data()))
         throw std::runtime_error("cannot run '" + program + "': " + std::strerror(error));
     int status = 0;
-    while (::waitpid(pid, &status, 0) < 0) {
-        if (errno != EINTR) throw std::runtime_error("lost track of POV-Ray: " + std::string(std::strerror(errno)));
+    while (!reap(pid, status, std::chrono::milliseconds(50))) {
+        if (cancel && cancel->load()) {
+            stop(pid);
+            throw Interrupted();  // `home` (POV-Ray's $HOME and log) is removed on the way out
+        }
     }
+    // Ctrl-C reaches POV-Ray too (same process group) and may end it before we look.
+    if (cancel && cancel->load()) throw Interrupted();
     run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     run.log = read_text(log);
-    if (!log_path.empty()) {
-        std::ofstream copy(log_path, std::ios::binary);
-        copy << run.log;
-    }
+    // Replaced as a whole (a symlink planted there is replaced, not followed).
+    if (!log_path.empty()) write_files_atomically({{log_path, run.log}});
 
     if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return run;
     const std::string how = WIFEXITED(status)     ? "exit status " + std::to_string(WEXITSTATUS(status))

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <atomic>
 #include <filesystem>
 #include <string>
 
@@ -32,8 +33,12 @@ struct PovrayRun {
 
 /// Renders `ini_path` (which names its scene and output) with POV-Ray, from the ini's
 /// directory, with a private writable $HOME. Nothing is printed: the output is captured and
-/// returned, and also written to `log_path` when one is given (even when POV-Ray fails).
-/// Throws std::runtime_error with the last lines of POV-Ray's output when it fails.
-PovrayRun run_povray(const std::string& ini_path, const std::string& log_path = "");
+/// returned, and also written to `log_path` when one is given (even when POV-Ray fails; the
+/// file is replaced, never written through a symlink found there). Throws std::runtime_error
+/// with the last lines of POV-Ray's output when it fails. When `cancel` becomes true POV-Ray
+/// is ended (SIGTERM, then SIGKILL if it has not exited within 2 s) and Interrupted (check.h)
+/// is thrown.
+PovrayRun run_povray(const std::string& ini_path, const std::string& log_path = "",
+                     const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace whitted::reference

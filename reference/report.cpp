@@ -80,13 +80,24 @@ void heat_colour(double difference, double tolerance, unsigned char* rgb) {
 
 /// Writes display-ready 8-bit pixels unchanged: the heat map's colours are already what should
 /// be seen, so no display transform may touch them.
+/// Written to a temporary beside `path` and moved into place: never through a symlink planted
+/// at `path`, and never half-written.
 void write_raw_png(const std::vector<unsigned char>& pixels, int width, int height, const fs::path& path) {
     auto out = OIIO::ImageOutput::create(path.string());
     if (!out) throw std::runtime_error("cannot write '" + path.string() + "': " + OIIO::geterror());
     OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
     spec.attribute("Software", "Whitted (whitted check)");
-    if (!out->open(path.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, pixels.data()) || !out->close())
+    const std::string temporary = temporary_path(path);
+    if (!out->open(temporary, spec) || !out->write_image(OIIO::TypeDesc::UINT8, pixels.data()) || !out->close()) {
+        std::remove(temporary.c_str());
         throw std::runtime_error("cannot write '" + path.string() + "': " + out->geterror());
+    }
+    try {
+        move_into_place(temporary, path);
+    } catch (...) {
+        std::remove(temporary.c_str());
+        throw;
+    }
 }
 
 Image absolute_difference(const Image& a, const Image& b) {
@@ -114,9 +125,17 @@ nlohmann::json metrics_json(const std::string& scene_path, const CheckResult& r,
     j["height"] = c.height;
     j["samples"] = r.samples;
     j["exposure"] = r.exposure;
-    j["tolerance"] = options.tolerance;
-    j["tolerance_codes"] = options.tolerance * 65535;
-    j["required_fraction"] = options.required_fraction;
+    j["failures"] = r.failures;
+    nlohmann::json rules = nlohmann::json::array();
+    for (const std::string& failure : r.failures) rules.push_back(failure.substr(0, failure.find(' ')));
+    j["failed_rules"] = rules;
+    j["tolerance"] = options.rule.tolerance;
+    j["tolerance_codes"] = options.rule.tolerance * 65535;
+    j["required_fraction"] = options.rule.required_fraction;
+    j["max_error_cap"] = options.rule.max_error;
+    j["max_error_cap_codes"] = options.rule.max_error * 65535;
+    j["compared"] = c.pixels > 0;
+    // An infinite error (NaN/Inf values) is written as null: JSON has no infinity.
     j["max_error"] = c.max_error;
     j["max_error_codes"] = c.max_error * 65535;
     j["mean_error"] = c.mean_error;
@@ -127,8 +146,17 @@ nlohmann::json metrics_json(const std::string& scene_path, const CheckResult& r,
     j["pixels"] = c.pixels;
     j["pixels_within"] = c.pixels_within;
     j["fraction_within"] = c.fraction_within();
-    j["worst_pixel"] = {
-        {"x", c.worst_x}, {"y", c.worst_y}, {"whitted", rgb_json(c.worst_ours)}, {"povray", rgb_json(c.worst_theirs)}};
+    j["nonfinite_whitted"] = c.nonfinite_ours;
+    j["nonfinite_povray"] = c.nonfinite_theirs;
+    nlohmann::json worst = nlohmann::json::array();
+    for (const PixelError& w : c.worst)
+        worst.push_back({{"x", w.x},
+                         {"y", w.y},
+                         {"error", w.error},
+                         {"error_codes", w.error * 65535},
+                         {"whitted", rgb_json(w.ours)},
+                         {"povray", rgb_json(w.theirs)}});
+    j["worst_pixels"] = worst;  // largest error first, at most CheckOptions::worst_count
     j["whitted_seconds"] = r.whitted_seconds;
     j["povray_seconds"] = r.povray_seconds;
     j["povray_runs"] = r.povray_runs;
@@ -139,31 +167,34 @@ nlohmann::json metrics_json(const std::string& scene_path, const CheckResult& r,
     return j;
 }
 
-std::string rgb_cells(const float* v) {
-    return fmt::format("<td>{:.6f}</td><td>{:.6f}</td><td>{:.6f}</td>", v[0], v[1], v[2]);
-}
-
 std::string code_cells(const float* v) {
     return fmt::format("<td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td>", double(v[0]) * 65535.0, double(v[1]) * 65535.0,
                        double(v[2]) * 65535.0);
 }
 
-/// One image of the side-by-side row, drawn with visible pixels and a box on the worst pixel.
+/// One image of the side-by-side row, drawn with visible pixels and a box on each of the worst
+/// pixels (the worst one solid, the others dashed).
 std::string figure(const std::string& file, const std::string& caption, const ImageComparison& c, int scale) {
+    std::string boxes;
+    for (size_t i = 0; i < c.worst.size(); ++i)
+        boxes += fmt::format(
+            "<div class=\"worst{}\" style=\"left:{}px;top:{}px;width:{s}px;height:{s}px\" title=\"#{} ({}, "
+            "{})\"></div>",
+            i == 0 ? "" : " other", c.worst[i].x * scale - 2, c.worst[i].y * scale - 2, i + 1, c.worst[i].x,
+            c.worst[i].y, fmt::arg("s", scale));
     return fmt::format(
         "<figure><div class=\"frame\" style=\"width:{w}px;height:{h}px\">"
-        "<a href=\"{f}\"><img src=\"{f}\" width=\"{w}\" height=\"{h}\" alt=\"{cap}\"></a>"
-        "<div class=\"worst\" style=\"left:{x}px;top:{y}px;width:{s}px;height:{s}px\" title=\"worst pixel\"></div>"
+        "<a href=\"{f}\"><img src=\"{f}\" width=\"{w}\" height=\"{h}\" alt=\"{cap}\"></a>{b}"
         "</div><figcaption>{cap}</figcaption></figure>\n",
         fmt::arg("w", c.width * scale), fmt::arg("h", c.height * scale), fmt::arg("f", file), fmt::arg("cap", caption),
-        fmt::arg("x", c.worst_x * scale - 2), fmt::arg("y", c.worst_y * scale - 2), fmt::arg("s", scale));
+        fmt::arg("b", boxes));
 }
 
 std::string report_html(const std::string& dir, const std::string& scene_path, const CheckResult& r,
                         const CheckOptions& options) {
     const ImageComparison& c = r.comparison;
     const std::string verdict = verdict_line(scene_path, r, options);
-    const double tolerance_codes = options.tolerance * 65535;
+    const double tolerance_codes = options.rule.tolerance * 65535;
     // Small test images are enlarged by a whole factor so single pixels can be seen.
     const int scale = std::clamp(320 / std::max({c.width, c.height, 1}), 1, 16);
     const std::string scene_abs = fs::absolute(scene_path).string();
@@ -191,6 +222,7 @@ figcaption { font-size: .9em; color: #444; margin-top: .3em; max-width: 420px; }
 .frame { position: relative; background: #888; }
 .frame img { display: block; image-rendering: pixelated; image-rendering: crisp-edges; }
 .worst { position: absolute; border: 2px solid #ff00ff; box-sizing: content-box; pointer-events: none; }
+.worst.other { border-style: dashed; border-color: #ff00ffa0; }
 table { border-collapse: collapse; margin-top: .4em; }
 td, th { border: 1px solid #ccc; padding: .2em .6em; text-align: right; font-variant-numeric: tabular-nums; }
 th { background: #f3f3f3; text-align: left; }
@@ -207,6 +239,17 @@ code { font-size: .95em; }
     h += "<p><span class=\"verdict " + std::string(r.passed ? "pass" : "fail") + "\">" + (r.passed ? "PASS" : "FAIL") +
          "</span> <code>" + html_escape(verdict) + "</code></p>\n";
 
+    if (!r.failures.empty()) {
+        h += "<p>Rules broken:</p>\n<ul>\n";
+        for (const std::string& failure : r.failures) h += "<li><code>" + html_escape(failure) + "</code></li>\n";
+        h += "</ul>\n";
+    }
+    if (c.pixels == 0) {
+        // Nothing to show side by side: the images could not be compared (their sizes differ).
+        h += "<p>The images were not compared. <a href=\"ours.exr\">ours.exr</a> and <a "
+             "href=\"povray.exr\">povray.exr</a> hold them as they are.</p>\n</body>\n</html>\n";
+        return h;
+    }
     h += "<h2>Images</h2>\n<div class=\"row\">\n";
     h += figure("ours.png", "Whitted (display sRGB of the linear image)", c, scale);
     h += figure("povray.png", "POV-Ray 3.7 (same display transform)", c, scale);
@@ -221,7 +264,8 @@ code { font-size: .95em; }
         "<div class=\"legend\"></div>\n<div class=\"legend-labels\"><span>0</span><span>{0:g} = tolerance</span>"
         "<span>≥ {1:g}</span></div>\n"
         "<p>Black to blue: within the tolerance (blue = exactly at it). Yellow to red: outside it (red = twice the "
-        "tolerance or more). The magenta box marks the worst pixel. Images shown {2}× enlarged"
+        "tolerance or more). The solid magenta box marks the worst pixel, dashed boxes the next worst ones "
+        "(listed below). Images shown {2}× enlarged"
         "{3}; click one for the file.</p>\n",
         tolerance_codes, 2 * tolerance_codes, scale,
         r.exposure != 1 ? fmt::format(", at exposure {:g}", r.exposure) : std::string());
@@ -230,13 +274,15 @@ code { font-size: .95em; }
     auto row = [&](const std::string& name, const std::string& value) {
         h += "<tr><th>" + name + "</th><td>" + value + "</td></tr>\n";
     };
-    row("max error", fmt::format("{:.3e} ({} codes)", c.max_error, format_codes(c.max_error)));
+    row("max error", fmt::format("{:.3e} ({} codes; cap {:g})", c.max_error, format_codes(c.max_error),
+                                 options.rule.max_error * 65535));
     row("mean error", fmt::format("{:.3e} ({:.3f} codes)", c.mean_error, c.mean_error * 65535));
     row("RMS error", fmt::format("{:.3e} ({:.3f} codes)", c.rms_error, c.rms_error * 65535));
     row("PSNR (peak 1)", std::isinf(c.psnr) ? std::string("∞ (identical)") : fmt::format("{:.1f} dB", c.psnr));
     row(fmt::format("pixels within {:g}/65535", tolerance_codes),
         fmt::format("{} ({} of {}; {:g}% required)", format_percent(c), c.pixels_within, c.pixels,
-                    100 * options.required_fraction));
+                    100 * options.rule.required_fraction));
+    row("NaN/Inf values", fmt::format("{} in Whitted's image, {} in POV-Ray's", c.nonfinite_ours, c.nonfinite_theirs));
     row("image",
         fmt::format("{}×{}, image.samples = {}{}", c.width, c.height, r.samples,
                     r.samples > 1 ? fmt::format(" (POV-Ray rendered {}×{} and each {}×{} block was averaged)",
@@ -248,16 +294,17 @@ code { font-size: .95em; }
     row("POV-Ray", "<code>" + html_escape(r.povray_program) + "</code>");
     h += "</table>\n";
 
-    h += fmt::format("<h2>Worst pixel ({}, {})</h2>\n", c.worst_x, c.worst_y);
-    h += "<p>Column from the left, row from the top; values are linear, at the compared exposure.</p>\n";
-    h += "<table>\n<tr><th></th><th>R</th><th>G</th><th>B</th><th>R codes</th><th>G codes</th><th>B codes</th></tr>\n";
-    h += "<tr><th>Whitted</th>" + rgb_cells(c.worst_ours) + code_cells(c.worst_ours) + "</tr>\n";
-    h += "<tr><th>POV-Ray</th>" + rgb_cells(c.worst_theirs) + code_cells(c.worst_theirs) + "</tr>\n";
-    float difference[3];
-    for (int ch = 0; ch < 3; ++ch) difference[ch] = c.worst_ours[ch] - c.worst_theirs[ch];
-    h += fmt::format("<tr><th>Whitted − POV-Ray</th><td>{:+.2e}</td><td>{:+.2e}</td><td>{:+.2e}</td>", difference[0],
-                     difference[1], difference[2]) +
-         code_cells(difference) + "</tr>\n</table>\n";
+    h += fmt::format("<h2>The {} worst pixels</h2>\n", c.worst.size());
+    h += "<p>Column from the left, row from the top; values are linear, at the compared exposure, in 16-bit codes "
+         "(× 65535). Error: the largest |Whitted − POV-Ray| of the three channels.</p>\n";
+    h += "<table>\n<tr><th>#</th><th>x</th><th>y</th><th>error (codes)</th><th>Whitted R</th><th>G</th><th>B</th>"
+         "<th>POV-Ray R</th><th>G</th><th>B</th></tr>\n";
+    for (size_t i = 0; i < c.worst.size(); ++i) {
+        const PixelError& w = c.worst[i];
+        h += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td>", i + 1, w.x, w.y, format_codes(w.error)) +
+             code_cells(w.ours) + code_cells(w.theirs) + "</tr>\n";
+    }
+    h += "</table>\n";
 
     h += "<h2>Files</h2>\n<ul>\n";
     const std::pair<const char*, const char*> files[] = {
@@ -278,7 +325,9 @@ code { font-size: .95em; }
     h += html_escape("whitted render " + shell_quote(scene_abs) + " -o ours.exr\n");
     h += html_escape("cd " + shell_quote(dir_abs) + " && HOME=$(mktemp -d) povray " + r.ini_file + "\n");
     h += html_escape("whitted check " + shell_quote(scene_abs) + " --report " + shell_quote(dir_abs) +
-                     fmt::format(" --tolerance {:g}", tolerance_codes) + "\n");
+                     fmt::format(" --tolerance {:g} --min-fraction {:g} --max-error {:g}", tolerance_codes,
+                                 options.rule.required_fraction, options.rule.max_error * 65535) +
+                     "\n");
     h += "</pre>\n<p>See <code>docs/validation.md</code> for the mapping, the conventions and the tolerance.</p>\n";
     h += "</body>\n</html>\n";
     return h;
@@ -293,26 +342,28 @@ void write_report(const std::string& dir, const std::string& scene_path, const I
     fs::create_directories(d, error);
     if (!fs::is_directory(d)) throw std::runtime_error("cannot create the report directory '" + dir + "'");
 
-    const Image difference = absolute_difference(ours, theirs);
     OutputOptions linear;
     linear.metadata = {{"whitted:scene", fs::absolute(scene_path).string()}};
     write_image(divided(ours, result.exposure), (d / "ours.exr").string(), linear);
     write_image(divided(theirs, result.exposure), (d / "povray.exr").string(), linear);
-    write_image(difference, (d / "diff.exr").string(), linear);
     // The default display transform (sRGB), the same for both so they look alike exactly when
     // they are alike.
     write_image(ours, (d / "ours.png").string(), {});
     write_image(theirs, (d / "povray.png").string(), {});
 
-    std::vector<unsigned char> heat(size_t(difference.width) * size_t(difference.height) * 3);
-    for (size_t i = 0; i < heat.size() / 3; ++i) {
-        const float* p = &difference.rgb[3 * i];
-        const double worst = std::isnan(p[0]) || std::isnan(p[1]) || std::isnan(p[2])
-                                 ? std::numeric_limits<double>::quiet_NaN()
-                                 : double(std::max({p[0], p[1], p[2]}));
-        heat_colour(worst, options.tolerance, &heat[3 * i]);
+    if (result.comparison.pixels > 0) {
+        const Image difference = absolute_difference(ours, theirs);
+        write_image(difference, (d / "diff.exr").string(), linear);
+        std::vector<unsigned char> heat(size_t(difference.width) * size_t(difference.height) * 3);
+        for (size_t i = 0; i < heat.size() / 3; ++i) {
+            const float* p = &difference.rgb[3 * i];
+            const double worst = std::isnan(p[0]) || std::isnan(p[1]) || std::isnan(p[2])
+                                     ? std::numeric_limits<double>::quiet_NaN()
+                                     : double(std::max({p[0], p[1], p[2]}));
+            heat_colour(worst, options.rule.tolerance, &heat[3 * i]);
+        }
+        write_raw_png(heat, difference.width, difference.height, d / "diff.png");
     }
-    write_raw_png(heat, difference.width, difference.height, d / "diff.png");
 
     const std::string metrics = metrics_json(scene_path, result, options).dump(2) + "\n";
     const std::string html = report_html(dir, scene_path, result, options);

@@ -257,6 +257,19 @@ int run_convert(const std::string& scene_path, const std::string& output) {
         if (ext != ".pov")
             throw std::invalid_argument("cannot convert to '" + output + "': unknown format '" + ext +
                                         "'; supported: .pov (POV-Ray 3.7)");
+        // Usage errors before any work: where the two files cannot go. (write_pov_files refuses a
+        // directory in the way too, before it replaces anything, for one that appears meanwhile.)
+        std::filesystem::path ini_path(output);
+        ini_path.replace_extension(".ini");
+        for (const std::filesystem::path& target : {std::filesystem::path(output), ini_path}) {
+            const std::filesystem::path dir = target.parent_path().empty() ? "." : target.parent_path();
+            std::error_code error;
+            if (!std::filesystem::is_directory(dir, error))
+                throw std::invalid_argument("cannot write '" + target.string() + "': directory '" + dir.string() +
+                                            "' does not exist");
+            if (std::filesystem::is_directory(target, error))
+                throw std::invalid_argument("cannot write '" + target.string() + "': it is a directory");
+        }
         const SceneDescription description = parse_scene_file(scene_path);
         validate_scene(description);  // refuse what Whitted itself would refuse
         const std::string ini = pov::write_pov_files(description, output);
@@ -274,24 +287,30 @@ int run_convert(const std::string& scene_path, const std::string& output) {
     }
 }
 
-int run_check_command(const std::string& scene_path, const reference::CheckOptions& options) {
+int run_check_command(const std::string& scene_path, reference::CheckOptions options) {
+    // Until the check has created its first file or directory a signal ends the program at once
+    // (g_exit_on_signal, cleared by run_check); from then on it stops POV-Ray, the temporary
+    // directories are removed and the exit status is 130/143.
+    options.cancel = &g_cancel;
+    options.exit_at_once = &g_exit_on_signal;
+    install_signal_handlers();
     // `check` lives in the OpenImageIO plug-in (whitted/output/plugin.h); it prints its own errors.
-    using RunCheck = int (*)(const std::string&, const reference::CheckOptions&);
+    using RunCheck = int (*)(const std::string&, const reference::CheckOptions&, const std::atomic<int>&);
     try {
         const auto run_check = reinterpret_cast<RunCheck>(image_io_plugin_symbol("whitted_run_check"));
-        return run_check(scene_path, options);
+        return run_check(scene_path, options, g_signal);
     } catch (const std::exception& e) {
         print_error(e.what());
         return exit_bad_input;
     }
 }
 
-int run_compare_command(const std::string& first, const std::string& second, double tolerance, bool clip,
-                        double required_fraction) {
-    using RunCompare = int (*)(const std::string&, const std::string&, double, bool, double);
+int run_compare_command(const std::string& first, const std::string& second, const reference::PassRule& rule,
+                        bool clip) {
+    using RunCompare = int (*)(const std::string&, const std::string&, const reference::PassRule&, bool);
     try {
         const auto run_compare = reinterpret_cast<RunCompare>(image_io_plugin_symbol("whitted_run_compare"));
-        return run_compare(first, second, tolerance, clip, required_fraction);
+        return run_compare(first, second, rule, clip);
     } catch (const std::exception& e) {
         print_error(e.what());
         return exit_bad_input;
@@ -389,7 +408,7 @@ int main(int argc, char** argv) {
 
     std::string check_scene;
     reference::CheckOptions check_options;
-    double tolerance_codes = 2.0;
+    double tolerance_codes = 2.0, max_error_codes = 64.0;
     CLI::App* check_cmd = app.add_subcommand(
         "check", "Render a scene with Whitted and with POV-Ray (converted) and compare them pixel by pixel");
     check_cmd->add_option("scene", check_scene, "Scene file")->required()->check(CLI::ExistingFile);
@@ -399,14 +418,20 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
     check_cmd
-        ->add_option("--min-fraction", check_options.required_fraction, "Share of pixels that must be within tolerance")
+        ->add_option("--min-fraction", check_options.rule.required_fraction,
+                     "Share of pixels that must be within tolerance")
         ->capture_default_str()
         ->check(CLI::Range(0.0, 1.0));
+    check_cmd
+        ->add_option("--max-error", max_error_codes,
+                     "Hard cap: no channel of any pixel may differ by more than this many 16-bit codes")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
     check_cmd->add_option("-t,--threads", check_options.threads, "Worker threads for Whitted (default: all cores)");
     check_cmd->add_flag("-q,--quiet", check_options.quiet, "Print only the verdict line");
 
     std::string compare_first, compare_second;
-    double compare_tolerance = 2.0, compare_fraction = 0.999;
+    double compare_tolerance = 2.0, compare_fraction = 0.999, compare_max_error = 64.0;
     bool compare_clip = false;
     CLI::App* compare_cmd =
         app.add_subcommand("compare", "Compare two images pixel by pixel (e.g. a Whitted EXR and a POV-Ray PNG)");
@@ -418,6 +443,11 @@ int main(int argc, char** argv) {
     compare_cmd->add_option("--min-fraction", compare_fraction, "Share of pixels that must be within tolerance")
         ->capture_default_str()
         ->check(CLI::Range(0.0, 1.0));
+    compare_cmd
+        ->add_option("--max-error", compare_max_error,
+                     "Hard cap: no channel of any pixel may differ by more than this many 16-bit codes")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
     compare_cmd->add_flag("--clip", compare_clip, "Clip both images to [0, 1] first (PNG files clip at 1)");
 
     try {
@@ -437,9 +467,14 @@ int main(int argc, char** argv) {
         std::_Exit(code);
     }
     if (*convert_cmd) return run_convert(convert_scene, convert_output);
-    if (*compare_cmd)
-        return run_compare_command(compare_first, compare_second, compare_tolerance / 65535.0, compare_clip,
-                                   compare_fraction);
-    check_options.tolerance = tolerance_codes / 65535.0;
+    if (*compare_cmd) {
+        reference::PassRule rule;
+        rule.tolerance = compare_tolerance / 65535.0;
+        rule.required_fraction = compare_fraction;
+        rule.max_error = compare_max_error / 65535.0;
+        return run_compare_command(compare_first, compare_second, rule, compare_clip);
+    }
+    check_options.rule.tolerance = tolerance_codes / 65535.0;
+    check_options.rule.max_error = max_error_codes / 65535.0;
     return run_check_command(check_scene, check_options);
 }

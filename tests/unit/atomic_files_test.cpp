@@ -8,11 +8,18 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace whitted {
@@ -68,6 +75,47 @@ TEST(AtomicFiles, FailedRenameLeavesNoTemporaryFile) {
         EXPECT_NE(std::string(e.what()).find("taken.ini"), std::string::npos) << e.what();
     }
     EXPECT_EQ(entries(directory.path()), std::vector<std::string>{"taken.ini"});
+}
+
+// `whitted convert`'s case: x.ini is a directory. Without the check before the renames, x.pov
+// was replaced and then the .ini's rename failed, leaving the new .pov beside no .ini.
+TEST(AtomicFiles, DirectoryInTheWayLeavesEveryOtherFileAsItWas) {
+    const test::ScratchDirectory directory;
+    write_files_atomically({{directory.path() / "x.pov", "old scene"}});
+    std::filesystem::create_directory(directory.path() / "x.ini");
+    try {
+        write_files_atomically({{directory.path() / "x.pov", "new scene"}, {directory.path() / "x.ini", "new ini"}});
+        ADD_FAILURE() << "a directory was replaced by a file";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("x.ini': it is a directory"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(bytes_of(directory.path() / "x.pov"), "old scene");
+    EXPECT_EQ(entries(directory.path()), (std::vector<std::string>{"x.ini", "x.pov"}));
+}
+
+// Two writers of the same files must not interleave their renames: each holds an flock on the
+// directory while it renames. Here the test holds it, so the writer must wait for it.
+TEST(AtomicFiles, RenamesWaitForTheDirectoryLock) {
+    const test::ScratchDirectory directory;
+    write_files_atomically({{directory.path() / "s.pov", "old"}, {directory.path() / "s.ini", "old"}});
+    const int lock = ::open(directory.path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    ASSERT_GE(lock, 0);
+    ASSERT_EQ(::flock(lock, LOCK_EX), 0);
+    std::atomic<bool> done{false};
+    std::thread writer([&] {
+        write_files_atomically({{directory.path() / "s.pov", "new"}, {directory.path() / "s.ini", "new"}});
+        done = true;
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    EXPECT_FALSE(done.load()) << "the files were renamed while another writer held the directory";
+    EXPECT_EQ(bytes_of(directory.path() / "s.pov"), "old");
+    EXPECT_EQ(bytes_of(directory.path() / "s.ini"), "old");
+    ::close(lock);  // releases the lock
+    writer.join();
+    EXPECT_TRUE(done.load());
+    EXPECT_EQ(bytes_of(directory.path() / "s.pov"), "new");
+    EXPECT_EQ(bytes_of(directory.path() / "s.ini"), "new");
+    EXPECT_EQ(entries(directory.path()), (std::vector<std::string>{"s.ini", "s.pov"}));
 }
 
 }  // namespace

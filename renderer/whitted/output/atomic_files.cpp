@@ -2,9 +2,11 @@
 #include "whitted/output/atomic_files.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -58,6 +60,72 @@ void name_file(Pending& file) {
     file.temporary = name;
 }
 
+/// Holds an exclusive flock on each directory given (in sorted order, so two writers never wait
+/// for each other crosswise) until destroyed. Every writer of a set of files takes it for its
+/// renames, so two of them can never interleave: `whitted convert` run twice at once to the
+/// same name leaves one run's .pov and .ini, never one of each. A lock on the directory itself
+/// leaves no lock file behind. Where flock is unsupported the writers are simply not serialised.
+class DirectoryLocks {
+public:
+    explicit DirectoryLocks(std::vector<std::filesystem::path> directories) {
+        std::sort(directories.begin(), directories.end());
+        directories.erase(std::unique(directories.begin(), directories.end()), directories.end());
+        for (const auto& directory : directories) {
+            const int fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+            if (fd < 0) continue;  // the rename will then fail with its own, clearer, reason
+            while (::flock(fd, LOCK_EX) != 0 && errno == EINTR) {
+            }
+            m_fds.push_back(fd);
+        }
+    }
+    ~DirectoryLocks() {
+        for (const int fd : m_fds) ::close(fd);  // closing releases the lock
+    }
+    DirectoryLocks(const DirectoryLocks&) = delete;
+    DirectoryLocks& operator=(const DirectoryLocks&) = delete;
+
+private:
+    std::vector<int> m_fds;
+};
+
+std::filesystem::path directory_of(const std::filesystem::path& target) {
+    return target.parent_path().empty() ? "." : target.parent_path();
+}
+
+/// A finished file moved to its target, and how to take that back.
+struct Moved {
+    std::filesystem::path target;
+    std::string temporary;    ///< after an exchange: the previous file, under the temporary name
+    bool exchanged = false;   ///< the previous file is at `temporary`
+    bool was_absent = false;  ///< nothing was at `target` before (undo: remove it)
+};
+
+Moved move_keeping_previous(const std::string& temporary, const std::filesystem::path& target) {
+    Moved moved{target, temporary};
+    struct stat existing {};
+    const bool exists = ::lstat(target.c_str(), &existing) == 0;
+    if (exists && S_ISREG(existing.st_mode) &&
+        ::renameat2(AT_FDCWD, temporary.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) == 0) {
+        moved.exchanged = true;
+        return moved;
+    }
+    if (std::rename(temporary.c_str(), target.c_str()) != 0)
+        throw std::runtime_error("cannot move the finished file to '" + target.string() + "': " + std::strerror(errno));
+    moved.was_absent = !exists;
+    return moved;
+}
+
+/// Puts back what was at a target before (best effort: this runs while an error is on its way).
+void undo(const Moved& moved) {
+    if (moved.exchanged) {
+        if (::renameat2(AT_FDCWD, moved.temporary.c_str(), AT_FDCWD, moved.target.c_str(), RENAME_EXCHANGE) == 0)
+            ::unlink(moved.temporary.c_str());  // the new file
+    } else if (moved.was_absent) {
+        ::unlink(moved.target.c_str());
+    }
+    // Else a symlink or other non-file was replaced by a rename: it cannot be brought back.
+}
+
 }  // namespace
 
 std::string temporary_path(const std::filesystem::path& target) {
@@ -97,10 +165,32 @@ void write_files_atomically(const std::vector<std::pair<std::filesystem::path, s
             file.fd = -1;
             if (::close(fd) != 0 && errno != EINTR) fail(file.target, "write failed");  // e.g. NFS quota
         }
-        for (Pending& file : pending) {
-            move_into_place(file.temporary, file.target);
-            file.temporary.clear();
+        // Refused before anything is renamed: a directory in the way would fail its rename
+        // after the files before it had already replaced theirs.
+        for (const Pending& file : pending) {
+            struct stat existing {};
+            if (::lstat(file.target.c_str(), &existing) == 0 && S_ISDIR(existing.st_mode)) {
+                throw std::runtime_error("cannot write '" + file.target.string() + "': it is a directory");
+            }
         }
+        std::vector<Moved> moved;
+        {
+            std::vector<std::filesystem::path> directories;
+            for (const Pending& file : pending) directories.push_back(directory_of(file.target));
+            const DirectoryLocks locks(directories);
+            try {
+                for (Pending& file : pending) {
+                    moved.push_back(move_keeping_previous(file.temporary, file.target));
+                    file.temporary.clear();
+                }
+            } catch (...) {
+                // All or nothing: the files already moved give their places back.
+                for (auto it = moved.rbegin(); it != moved.rend(); ++it) undo(*it);
+                throw;
+            }
+        }
+        for (const Moved& file : moved)
+            if (file.exchanged) ::unlink(file.temporary.c_str());  // the previous file
     } catch (...) {
         for (Pending& file : pending) {
             if (file.fd >= 0) ::close(file.fd);

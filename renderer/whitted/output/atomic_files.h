@@ -15,7 +15,11 @@ namespace whitted {
 /// link to temporary_path(NAME), then move_into_place). Where a filesystem cannot make
 /// unnamed files, the named temporary is written directly (and removed on failure; a kill can
 /// leave it). Throws std::runtime_error naming the file and the reason. Nothing is renamed
-/// before every file is written; the renames come last, one after the other.
+/// before every file is written; the renames come last, one after the other, all or nothing:
+/// a target that is a directory is refused before any rename, and if a rename fails the files
+/// already moved are put back (an existing regular file is restored; only a symlink or other
+/// non-file replaced by a rename cannot be). The renames hold an flock on the directory, so two
+/// processes writing the same set of files at once leave one's whole set, never a mix.
 /// `.NAME.whitted-PID.tmp.EXT` beside `target`: where a file is finished before it is moved to
 /// `target` (hidden, and marked as ours, by process).
 std::string temporary_path(const std::filesystem::path& target);

@@ -1,0 +1,49 @@
+# SPDX-License-Identifier: MIT
+"""A stand-in for POV-Ray (run through WHITTED_POVRAY) that writes an image with known pixels,
+or hangs, so that `whitted check` can be given exactly the POV-Ray output a test needs.
+Reads Output_File_Name and +W/+H from the .ini it is given. The environment says what to do:
+  FAKE_POVRAY_MODE     image (default) | hang | hang-ignoring-signals
+  FAKE_POVRAY_CODES    r,g,b: the 16-bit code of every pixel (default 0,0,0)
+  FAKE_POVRAY_PIXELS   x,y,channel,code;...: pixels that differ
+  FAKE_POVRAY_SIZE     WxH instead of the .ini's size
+  FAKE_POVRAY_CHANNELS 3 (default) or 4 (RGBA)
+  FAKE_POVRAY_PIDFILE  where a hanging one writes its process id"""
+
+import os
+import re
+import signal
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import images  # noqa: E402
+
+
+def main():
+    text = open(sys.argv[1]).read()
+    mode = os.environ.get("FAKE_POVRAY_MODE", "image")
+    if mode.startswith("hang"):
+        if mode == "hang-ignoring-signals":
+            signal.signal(signal.SIGTERM, signal.SIG_IGN)
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+        pidfile = os.environ["FAKE_POVRAY_PIDFILE"]
+        with open(pidfile + ".tmp", "w") as f:
+            f.write(str(os.getpid()))
+        os.rename(pidfile + ".tmp", pidfile)
+        while True:
+            time.sleep(1)
+    output = re.search(r'Output_File_Name="([^"]*)"', text).group(1)
+    width, height = int(re.search(r"\+W(\d+)", text).group(1)), int(re.search(r"\+H(\d+)", text).group(1))
+    if "FAKE_POVRAY_SIZE" in os.environ:
+        width, height = (int(v) for v in os.environ["FAKE_POVRAY_SIZE"].split("x"))
+    codes = [int(v) for v in os.environ.get("FAKE_POVRAY_CODES", "0,0,0").split(",")]
+    overrides = {}
+    for item in filter(None, os.environ.get("FAKE_POVRAY_PIXELS", "").split(";")):
+        x, y, c, code = (int(v) for v in item.split(","))
+        overrides[(x, y, c)] = code
+    images.png16(output, width, height, codes, overrides, int(os.environ.get("FAKE_POVRAY_CHANNELS", "3")))
+    print("fake POV-Ray wrote", output)
+
+
+if __name__ == "__main__":
+    main()
