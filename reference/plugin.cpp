@@ -4,6 +4,7 @@
 // compiler, so they pass C++ types.
 
 #include "reference/check.h"
+#include "reference/file_colour.h"
 #include "whitted/scene/source_location.h"
 
 #include <OpenImageIO/imageio.h>
@@ -59,15 +60,22 @@ __attribute__((visibility("default"))) int whitted_run_check(const std::string& 
     }
 }
 
-/// `whitted compare A B`: per-channel comparison of two images of the same size; with `clip`
-/// both are first clipped to [0, 1] (to compare a float EXR with a PNG, which clips).
+/// `whitted compare A B`: per-channel comparison of two images of the same size, each first
+/// converted to linear Rec.709 from its colour metadata (refused, exit 2, when that is not
+/// known); with `clip` both are then clipped to [0, 1] (to compare a float EXR with a PNG,
+/// which clips).
 /// Returns 0 when at least `required_fraction` of the pixels are within `tolerance`, else 1; 2
 /// when an image cannot be read or the sizes differ.
 __attribute__((visibility("default"))) int whitted_run_compare(const std::string& first, const std::string& second,
                                                                double tolerance, bool clip, double required_fraction) {
     using namespace whitted::reference;
     try {
-        whitted::Image a = read_linear_image(first), b = read_linear_image(second);
+        // Each file as what its metadata says it is, in linear Rec.709: a linear EXR against a
+        // display-referred PNG compares light with light, not light with display codes.
+        const LinearImage first_linear = read_as_linear_rec709(first), second_linear = read_as_linear_rec709(second);
+        std::printf("%s: %s\n%s: %s\n", first.c_str(), first_linear.meaning.c_str(), second.c_str(),
+                    second_linear.meaning.c_str());
+        whitted::Image a = first_linear.image, b = second_linear.image;
         if (a.width != b.width || a.height != b.height) {
             std::fprintf(stderr, "whitted: error: %s is %dx%d but %s is %dx%d\n", first.c_str(), a.width, a.height,
                          second.c_str(), b.width, b.height);

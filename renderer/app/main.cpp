@@ -479,7 +479,9 @@ int main(int argc, char** argv) {
     double compare_tolerance = 2.0, compare_fraction = 0.999;
     bool compare_clip = false;
     CLI::App* compare_cmd =
-        app.add_subcommand("compare", "Compare two images pixel by pixel (e.g. a Whitted EXR and a POV-Ray PNG)");
+        app.add_subcommand("compare",
+                           "Compare two images pixel by pixel (e.g. a Whitted EXR and a POV-Ray PNG), each first "
+                           "turned into linear Rec.709 from its colour metadata");
     compare_cmd->add_option("first", compare_first, "Image")->required()->check(CLI::ExistingFile);
     compare_cmd->add_option("second", compare_second, "Image of the same size")->required()->check(CLI::ExistingFile);
     compare_cmd->add_option("--tolerance", compare_tolerance, "Per-channel tolerance in 16-bit codes (1/65535)")
