@@ -42,7 +42,13 @@ __attribute__((visibility("default"))) std::string whitted_write_display_image(
     // OpenImageIO rounds and clamps the floats to the integer range.
     const bool wrote = out->write_image(OIIO::TypeDesc::FLOAT, rgb);
     const bool closed = out->close();
-    return wrote && closed ? std::string() : out->geterror();
+    if (wrote && closed) return "";
+    // OpenImageIO's errors can run over several lines (libtiff's and its own): one line here.
+    std::string error = out->geterror();
+    while (!error.empty() && error.back() == '\n') error.pop_back();
+    std::string line;
+    for (const char c : error) line += c == '\n' ? std::string("; ") : std::string(1, c);
+    return line;
 }
 
 /// `whitted check`: returns the exit status (0 pass, 1 images differ, 2 cannot check) and

@@ -4,6 +4,7 @@
 #include "whitted/output/atomic_files.h"
 #include "whitted/output/color_management.h"
 #include "whitted/output/icc_profile.h"
+#include "whitted/output/jpeg_file.h"
 
 #include "whitted/output/plugin.h"
 #include "whitted/output/png_file.h"
@@ -140,7 +141,8 @@ void check_output_options(const std::string& path, const OutputOptions& options)
         DisplayTransform(options.ocio_config, options.display, options.view);  // loads the config, finds the names
 }
 
-/// The plug-in's writer for JPEG and TIFF (8/16-bit); see plugin.h. PNG is written here (png_file.h).
+/// The plug-in's writer for TIFF (8/16-bit); see plugin.h. PNG and JPEG are written here
+/// (png_file.h, jpeg_file.h).
 using WriteDisplayImage = std::string (*)(const std::string& format_path, const std::string& temp_path, int width,
                                           int height, const float* rgb, int bits,
                                           const std::vector<std::pair<std::string, std::string>>& metadata,
@@ -191,23 +193,19 @@ void write_exr(const Image& image, const std::string& temp_path, bool half, Imf:
         file.setFrameBuffer(frame);
         file.writePixels(image.height);
     } catch (const std::exception& e) {
-        throw std::runtime_error(std::string("cannot write the EXR file: ") + e.what());
+        throw std::runtime_error(std::string("OpenEXR: ") + e.what());
     }
 }
 
-}  // namespace
-
-void write_image(const Image& image, const std::string& path, const OutputOptions& options) {
+/// write_image's work, into `temp_path`.
+void write_to(const std::string& temp_path, const Image& image, const std::string& path, const OutputOptions& options,
+              std::vector<std::pair<std::string, std::string>> metadata) {
     const OutputKind kind = output_kind(path);
-    check_format_options(path, options);
     const std::string ext = lower_extension(path);
-    std::vector<std::pair<std::string, std::string>> metadata{{"Software", "Whitted " WHITTED_VERSION}};
-
-    TemporaryFile temporary(path);
     if (kind == OutputKind::linear_exr) {
         metadata.push_back({"whitted:colorspace", "Linear Rec.709 (sRGB)"});
         metadata.insert(metadata.end(), options.metadata.begin(), options.metadata.end());
-        write_exr(image, temporary.path(), options.half, exr_compression(options.exr_compression), metadata);
+        write_exr(image, temp_path, options.half, exr_compression(options.exr_compression), metadata);
     } else {
         const DisplayTransform display(options.ocio_config, options.display, options.view);
         const int bits = options.bit_depth ? options.bit_depth : (is_tiff(ext) ? 16 : 8);
@@ -218,19 +216,41 @@ void write_image(const Image& image, const std::string& path, const OutputOption
         metadata.push_back({"whitted:view", display.view()});
         metadata.insert(metadata.end(), options.metadata.begin(), options.metadata.end());
         if (ext == ".png") {
-            write_png(temporary.path(), image, display, bits, metadata);
+            write_png(temp_path, image, display, bits, metadata);
         } else {
             std::vector<float> pixels = image.rgb;
             display.apply(pixels.data(), pixels.size() / 3);
             const std::vector<unsigned char> profile =
                 icc_profile(display.encoding(), "Whitted: " + display.display() + " / " + display.view() + " (" +
                                                     display.colorspace() + ")");
-            const auto write =
-                reinterpret_cast<WriteDisplayImage>(image_io_plugin_symbol("whitted_write_display_image"));
-            const std::string error =
-                write(path, temporary.path(), image.width, image.height, pixels.data(), bits, metadata, profile);
-            if (!error.empty()) throw std::runtime_error("cannot write '" + path + "': " + error);
+            if (is_jpeg(ext)) {
+                write_jpeg(temp_path, image.width, image.height, pixels.data(), metadata, profile);
+            } else {
+                const auto write =
+                    reinterpret_cast<WriteDisplayImage>(image_io_plugin_symbol("whitted_write_display_image"));
+                const std::string error =
+                    write(path, temp_path, image.width, image.height, pixels.data(), bits, metadata, profile);
+                if (!error.empty()) throw std::runtime_error(error);
+            }
         }
+    }
+}
+
+}  // namespace
+
+void write_image(const Image& image, const std::string& path, const OutputOptions& options) {
+    check_format_options(path, options);
+    std::vector<std::pair<std::string, std::string>> metadata{{"Software", "Whitted " WHITTED_VERSION}};
+
+    TemporaryFile temporary(path);
+    // Every writer's failure as one message naming the file (the temporary is removed by
+    // `temporary`; the existing file is untouched).
+    try {
+        write_to(temporary.path(), image, path, options, metadata);
+    } catch (const std::invalid_argument&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw std::runtime_error("cannot write '" + path + "': " + e.what());
     }
     temporary.commit(path);
 }

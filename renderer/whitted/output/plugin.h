@@ -5,7 +5,7 @@
 
 namespace whitted {
 
-/// Code that needs OpenImageIO (PNG/JPEG/TIFF output, reading images, `whitted check`) lives in
+/// Code that needs OpenImageIO (TIFF output, reading images, `whitted check`/`compare`) lives in
 /// a plug-in, lib/libwhitted_oiio.so, loaded on first use. Linking OpenImageIO into the program
 /// would cost every run about 0.2 s of start-up (it pulls in ~250 shared libraries), most of a
 /// small render's time; an EXR render never loads it.

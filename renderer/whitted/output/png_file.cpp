@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -37,8 +38,12 @@ struct PngJob {
 };
 
 extern "C" void on_png_error(png_structp png, png_const_charp message) {
+    const int reason = errno;  // libpng's "Write Error" does not say why (a full disk, a quota)
     auto* job = static_cast<PngJob*>(png_get_error_ptr(png));
-    std::snprintf(job->error, sizeof job->error, "%s", message);
+    if (reason)
+        std::snprintf(job->error, sizeof job->error, "%s (%s)", message, std::strerror(reason));
+    else
+        std::snprintf(job->error, sizeof job->error, "%s", message);
     png_longjmp(png, 1);
 }
 
@@ -218,6 +223,7 @@ void write_png(const std::string& path, const Image& linear, const DisplayTransf
     const std::vector<unsigned char> idat = compress_rows(rows.data(), row_bytes, height, bits);
     PngJob job{file, width, height, bits, idat.data(), idat.size(), texts.data(), int(texts.size()), display.encoding(),
                {}};
+    errno = 0;
     const bool wrote = run(job);
     const bool closed = std::fclose(file) == 0;
     if (!wrote) throw std::runtime_error(std::string("libpng: ") + job.error);
