@@ -17,40 +17,6 @@
 
 extern "C" {
 
-/// Writes display-referred RGB (already through the OCIO transform) as an 8- or 16-bit file of
-/// the type `format_path`'s extension names, to `temp_path`, with `icc_profile` (if any) saying
-/// what the codes mean. Returns "" or the error.
-__attribute__((visibility("default"))) std::string whitted_write_display_image(
-    const std::string& format_path, const std::string& temp_path, int width, int height, const float* rgb, int bits,
-    const std::vector<std::pair<std::string, std::string>>& metadata, const std::vector<unsigned char>& icc_profile) {
-    OIIO::ImageSpec spec(width, height, 3, bits == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
-    // JPEG and TIFF have no free-form keys: OpenImageIO drops the whitted:* attributes, so they
-    // also go, one "key: value" a line, into the image description (a JPEG comment, TIFF's
-    // ImageDescription tag), which every reader shows.
-    std::string description;
-    for (const auto& [key, value] : metadata) {
-        spec.attribute(key, value);
-        if (key != "Software") description += key + ": " + value + "\n";
-    }
-    spec.attribute("ImageDescription", description);
-    if (!icc_profile.empty())
-        spec.attribute("ICCProfile", OIIO::TypeDesc(OIIO::TypeDesc::UINT8, int(icc_profile.size())),
-                       icc_profile.data());
-    auto out = OIIO::ImageOutput::create(format_path);
-    if (!out) return OIIO::geterror();
-    if (!out->open(temp_path, spec)) return out->geterror();
-    // OpenImageIO rounds and clamps the floats to the integer range.
-    const bool wrote = out->write_image(OIIO::TypeDesc::FLOAT, rgb);
-    const bool closed = out->close();
-    if (wrote && closed) return "";
-    // OpenImageIO's errors can run over several lines (libtiff's and its own): one line here.
-    std::string error = out->geterror();
-    while (!error.empty() && error.back() == '\n') error.pop_back();
-    std::string line;
-    for (const char c : error) line += c == '\n' ? std::string("; ") : std::string(1, c);
-    return line;
-}
-
 /// `whitted check`: returns the exit status (0 pass, 1 images differ, 2 cannot check) and
 /// prints its own messages.
 __attribute__((visibility("default"))) int whitted_run_check(const std::string& scene_path,

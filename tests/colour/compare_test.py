@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: MIT
 """`whitted compare` knows what it compares (docs/colour.md): a linear EXR against the same
-render written through each display (sRGB, Gamma 2.2, BT.1886, Display P3, Raw; PNG and TIFF)
+render written through each display (sRGB, Gamma 2.2, BT.1886, Display P3, Raw; PNG, TIFF, JPEG)
 passes, because both are turned into linear Rec.709 from their metadata, and it says so for each
 file; within the quantisation of the display-referred file only, so a wrong decoding (display
 codes taken as light, or the wrong curve) fails. A file whose values are no known transfer
@@ -56,13 +56,17 @@ with tempfile.TemporaryDirectory() as work:
         ("raw16.png", ["--view", "Raw", "--bit-depth", "16"], 2),
         ("srgb16.tif", ["--display", "sRGB"], 3),
         ("p3-16.tif", ["--display", "Display P3"], 3),
+        ("gamma22-8.tif", ["--display", "Gamma 2.2", "--bit-depth", "8"], 320),
+        # JPEG is lossy: within 3000 codes for 99 % of the pixels (most are far closer).
+        ("srgb.jpg", ["--display", "sRGB"], 3000, 0.99),
     ]
-    for name, options, tolerance in cases:
+    for name, options, tolerance, *fraction in cases:
+        fraction = str(fraction[0] if fraction else 1)
         result = run(["render", scene, "-q", "-o", name] + options, work)
         if result.returncode != 0:
             failures.append(f"{name}: render failed: {result.stderr.strip()}")
             continue
-        result = run(["compare", "linear.exr", name, "--clip", "--tolerance", str(tolerance), "--min-fraction", "1"],
+        result = run(["compare", "linear.exr", name, "--clip", "--tolerance", str(tolerance), "--min-fraction", fraction],
                      work)
         out = result.stdout
         if result.returncode != 0:
@@ -75,8 +79,8 @@ with tempfile.TemporaryDirectory() as work:
         else:
             print(f"ok   {name}: {out.strip().splitlines()[-1]}")
         # Tighter than the file's quantisation allows must fail: the tolerance above is earned.
-        tight = run(["compare", "linear.exr", name, "--clip", "--tolerance", str(tolerance / 8), "--min-fraction", "1"],
-                    work)
+        tight = run(["compare", "linear.exr", name, "--clip", "--tolerance", str(tolerance / 8), "--min-fraction",
+                     fraction], work)
         if tight.returncode != 1:
             failures.append(f"{name}: at a tolerance of {tolerance / 8} codes compare exits {tight.returncode}, not 1")
 

@@ -6,8 +6,8 @@
 #include "whitted/output/icc_profile.h"
 #include "whitted/output/jpeg_file.h"
 
-#include "whitted/output/plugin.h"
 #include "whitted/output/png_file.h"
+#include "whitted/output/tiff_file.h"
 
 #include <Imath/half.h>
 #include <OpenEXR/ImfChannelList.h>
@@ -141,13 +141,6 @@ void check_output_options(const std::string& path, const OutputOptions& options)
         DisplayTransform(options.ocio_config, options.display, options.view);  // loads the config, finds the names
 }
 
-/// The plug-in's writer for TIFF (8/16-bit); see plugin.h. PNG and JPEG are written here
-/// (png_file.h, jpeg_file.h).
-using WriteDisplayImage = std::string (*)(const std::string& format_path, const std::string& temp_path, int width,
-                                          int height, const float* rgb, int bits,
-                                          const std::vector<std::pair<std::string, std::string>>& metadata,
-                                          const std::vector<unsigned char>& icc_profile);
-
 namespace {
 
 Imf::Compression exr_compression(const std::string& name) {
@@ -223,15 +216,10 @@ void write_to(const std::string& temp_path, const Image& image, const std::strin
             const std::vector<unsigned char> profile =
                 icc_profile(display.encoding(), "Whitted: " + display.display() + " / " + display.view() + " (" +
                                                     display.colorspace() + ")");
-            if (is_jpeg(ext)) {
+            if (is_jpeg(ext))
                 write_jpeg(temp_path, image.width, image.height, pixels.data(), metadata, profile);
-            } else {
-                const auto write =
-                    reinterpret_cast<WriteDisplayImage>(image_io_plugin_symbol("whitted_write_display_image"));
-                const std::string error =
-                    write(path, temp_path, image.width, image.height, pixels.data(), bits, metadata, profile);
-                if (!error.empty()) throw std::runtime_error(error);
-            }
+            else
+                write_tiff(temp_path, image.width, image.height, pixels.data(), bits, metadata, profile);
         }
     }
 }

@@ -7,6 +7,7 @@
 #include "whitted/output/jpeg_file.h"
 
 #include <jpeglib.h>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -118,9 +119,11 @@ void write_jpeg(const std::string& path, int width, int height, const float* rgb
                 const std::vector<std::pair<std::string, std::string>>& metadata,
                 const std::vector<unsigned char>& icc_profile) {
     std::vector<unsigned char> rows(size_t(width) * size_t(height) * 3);
-    tbb::parallel_for(size_t(0), rows.size(), size_t(65536), [&](size_t i) {
-        const float v = rgb[i] > 0 ? std::min(rgb[i], 1.0f) : 0.0f;  // NaN fails `> 0`
-        rows[i] = static_cast<unsigned char>(double(v) * 255.0 + 0.5);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, rows.size(), 65536), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t i = range.begin(); i != range.end(); ++i) {
+            const float v = rgb[i] > 0 ? std::min(rgb[i], 1.0f) : 0.0f;  // NaN fails `> 0`
+            rows[i] = static_cast<unsigned char>(double(v) * 255.0 + 0.5);
+        }
     });
     std::string comment, software;
     for (const auto& [key, value] : metadata) {
