@@ -14,6 +14,8 @@ find_package(OpenImageIO CONFIG REQUIRED)
 find_package(OpenEXR CONFIG REQUIRED)
 find_package(Imath CONFIG REQUIRED)
 find_package(PNG REQUIRED)
+find_package(JPEG REQUIRED)
+find_package(TIFF REQUIRED)
 find_package(ZLIB REQUIRED)
 
 # Quirk A: Debian built OpenImageIO with OpenCV, and its exported target names

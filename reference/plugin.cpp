@@ -4,6 +4,7 @@
 // compiler, so they pass C++ types.
 
 #include "reference/check.h"
+#include "reference/file_colour.h"
 #include "whitted/scene/source_location.h"
 
 #include <OpenImageIO/imageio.h>
@@ -18,22 +19,6 @@
 #include <vector>
 
 extern "C" {
-
-/// Writes display-referred RGB (already through the OCIO transform) as an 8- or 16-bit file of
-/// the type `format_path`'s extension names, to `temp_path`. Returns "" or the error.
-__attribute__((visibility("default"))) std::string whitted_write_display_image(
-    const std::string& format_path, const std::string& temp_path, int width, int height, const float* rgb, int bits,
-    const std::vector<std::pair<std::string, std::string>>& metadata) {
-    OIIO::ImageSpec spec(width, height, 3, bits == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
-    for (const auto& [key, value] : metadata) spec.attribute(key, value);
-    auto out = OIIO::ImageOutput::create(format_path);
-    if (!out) return OIIO::geterror();
-    if (!out->open(temp_path, spec)) return out->geterror();
-    // OpenImageIO rounds and clamps the floats to the integer range.
-    const bool wrote = out->write_image(OIIO::TypeDesc::FLOAT, rgb);
-    const bool closed = out->close();
-    return wrote && closed ? std::string() : out->geterror();
-}
 
 /// `whitted check`: returns the exit status (0 pass, 1 images differ, 2 cannot check, 128 +
 /// the signal when interrupted) and prints its own messages.
@@ -58,9 +43,10 @@ __attribute__((visibility("default"))) int whitted_run_check(const std::string& 
 }
 
 /// `whitted compare A B`: per-channel comparison of two images under `rule` (the share, cap,
-/// finite, size and channels rules); with `clip` both are first clipped to [0, 1] (to compare
-/// a float EXR with a PNG, which clips), NaN/Inf values counted before that. Returns 0 when
-/// every rule holds, else 1; 2 when an image cannot be read.
+/// finite, size and channels rules), each first converted to linear Rec.709 from its colour
+/// metadata (refused, exit 2, when that is not known); with `clip` both are then clipped to
+/// [0, 1] (to compare a float EXR with a PNG, which clips), NaN/Inf values counted before that.
+/// Returns 0 when every rule holds, else 1; 2 when an image cannot be read or decoded.
 __attribute__((visibility("default"))) int whitted_run_compare(const std::string& first, const std::string& second,
                                                                const whitted::reference::PassRule& rule, bool clip) {
     using namespace whitted::reference;
@@ -73,7 +59,12 @@ __attribute__((visibility("default"))) int whitted_run_compare(const std::string
             std::printf("%s\n", verdict_text(subject, "", failures).c_str());
             return 1;
         }
-        whitted::Image a = read_linear_image(first), b = read_linear_image(second);
+        // Each file as what its metadata says it is, in linear Rec.709: a linear EXR against a
+        // display-referred PNG compares light with light, not light with display codes.
+        const LinearImage first_linear = read_as_linear_rec709(first), second_linear = read_as_linear_rec709(second);
+        std::printf("%s: %s\n%s: %s\n", first.c_str(), first_linear.meaning.c_str(), second.c_str(),
+                    second_linear.meaning.c_str());
+        whitted::Image a = first_linear.image, b = second_linear.image;
         size_t nonfinite[2] = {0, 0};
         int index = 0;
         for (auto* image : {&a, &b}) {

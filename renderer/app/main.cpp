@@ -5,6 +5,8 @@
 
 #include "converters/pov_writer.h"
 #include "reference/check.h"
+#include "whitted/output/atomic_files.h"
+#include "whitted/output/color_management.h"
 #include "whitted/output/image_output.h"
 #include "whitted/output/plugin.h"
 #include "whitted/render/accelerator.h"
@@ -128,10 +130,37 @@ struct RenderArguments {
     std::string scene, output = "whitted.png";
     int threads = 0;
     bool quiet = false, half = false, partial = false, stats = false;
-    std::string exr_compression = "none";
+    std::string exr_compression;  // empty: not given (none)
     int bit_depth = 0;
     std::string ocio_config, display, view;
 };
+
+OutputOptions output_options(const RenderArguments& args) {
+    OutputOptions output;
+    output.half = args.half;
+    output.exr_compression = args.exr_compression;
+    output.bit_depth = args.bit_depth;
+    output.ocio_config = args.ocio_config;
+    output.display = args.display;
+    output.view = args.view;
+    return output;
+}
+
+/// Refuses an output that is one of the render's input files (`whitted render s.png -o s.png`
+/// once overwrote the scene): the same file by any name, a link included.
+void refuse_output_over(const std::string& output, const std::string& input, const char* what) {
+    std::error_code error;
+    if (std::filesystem::equivalent(output, input, error))
+        throw std::invalid_argument("refusing to write the image to '" + output + "': it is the " + what + " '" +
+                                    input + "'");
+}
+
+void collect_mesh_files(const std::vector<ObjectDescription>& objects, std::vector<std::string>& files) {
+    for (const ObjectDescription& object : objects) {
+        if (!object.file_path.empty()) files.push_back(object.file_path);
+        collect_mesh_files(object.children, files);
+    }
+}
 
 /// Wall-clock time of each stage, printed by --stats.
 class StageTimer {
@@ -153,10 +182,17 @@ int run_render(const RenderArguments& args) {
     Scene scene;
     double parse_seconds = 0, validate_seconds = 0;
     install_signal_handlers();
+    OutputOptions output = output_options(args);
     try {
+        // Usage first, in milliseconds: nothing here reads the scene.
         check_output_path(args.output);
+        check_output_options(args.output, output);
+        refuse_output_over(args.output, args.scene, "scene file");
         const SceneDescription description = parse_scene_file(args.scene);
         parse_seconds = timer.lap();
+        std::vector<std::string> meshes;
+        collect_mesh_files(description.objects, meshes);
+        for (const std::string& mesh : meshes) refuse_output_over(args.output, mesh, "mesh file");
         scene = validate_scene(description);
         validate_seconds = timer.lap();
     } catch (const InputError& e) {
@@ -190,16 +226,13 @@ int run_render(const RenderArguments& args) {
         if (options.on_progress) std::fputc('\n', stderr);
         timer.lap();
 
-        OutputOptions output;
-        output.half = args.half;
-        output.exr_compression = args.exr_compression;
-        output.bit_depth = args.bit_depth;
-        output.ocio_config = args.ocio_config;
-        output.display = args.display;
-        output.view = args.view;
-        output.metadata = {{"whitted:scene", std::filesystem::absolute(args.scene).string()},
-                           {"whitted:render_seconds", fmt::format("{:.3f}", result.seconds)},
-                           {"whitted:rays", std::to_string(result.rays.total())}};
+        // The scene's file name only: a file sent on should not carry this machine's paths.
+        output.metadata = {
+            {"whitted:scene", std::filesystem::path(args.scene).filename().string()},
+            {"whitted:settings", fmt::format("{}x{}, {} sample(s)/pixel, max depth {}", scene.width, scene.height,
+                                             scene.samples * scene.samples, scene.max_depth)},
+            {"whitted:render_seconds", fmt::format("{:.3f}", result.seconds)},
+            {"whitted:rays", std::to_string(result.rays.total())}};
         if (result.cancelled) {
             const int signal = g_signal.load();
             if (args.partial) {
@@ -317,6 +350,25 @@ int run_compare_command(const std::string& first, const std::string& second, con
     }
 }
 
+int run_colour(bool list, const std::string& config, const std::string& write_config) {
+    try {
+        if (!config.empty() && !list) throw std::invalid_argument("--ocio-config goes with --list");
+        if (!write_config.empty()) {
+            const std::string text = DisplayTransform::builtin_config_text();
+            write_files_atomically({{write_config, text}});
+            std::fprintf(stderr, "whitted: wrote the built-in OpenColorIO config to %s\n", write_config.c_str());
+        }
+        if (list) std::fputs(DisplayTransform::describe_config(config).c_str(), stdout);
+        return exit_ok;
+    } catch (const std::invalid_argument& e) {
+        print_error(e.what());
+        return exit_bad_input;
+    } catch (const std::exception& e) {
+        print_error(e.what());
+        return exit_failure;
+    }
+}
+
 /// `whitted --version`: the program's version and, since it decides which of Embree's code
 /// paths run, the instruction sets Embree can use here and the one in use.
 std::string version_text() {
@@ -384,15 +436,20 @@ int main(int argc, char** argv) {
     render_cmd->add_flag("--half", render_args.half, "EXR: write half floats instead of 32-bit floats");
     render_cmd
         ->add_option("--exr-compression", render_args.exr_compression,
-                     "EXR compression, all lossless: none (fastest to write), zip, zips, piz, rle")
-        ->capture_default_str()
+                     "EXR compression, all lossless: none (the default, fastest to write), zip, zips, piz, rle")
         ->check(CLI::IsMember({"none", "zip", "zips", "piz", "rle"}));
-    render_cmd->add_option("--bit-depth", render_args.bit_depth, "PNG/TIFF bits per channel (8 or 16)")
+    render_cmd
+        ->add_option("--bit-depth", render_args.bit_depth,
+                     "PNG/TIFF bits per channel, 8 or 16 (default: PNG 8, TIFF 16; JPEG is 8 only)")
         ->check(CLI::IsMember({8, 16}));
     render_cmd->add_option("--ocio-config", render_args.ocio_config,
-                           "OpenColorIO config file (default: $OCIO, else the built-in sRGB config)");
-    render_cmd->add_option("--display", render_args.display, "OCIO display (default: the config's default)");
-    render_cmd->add_option("--view", render_args.view, "OCIO view (default: the display's default)");
+                           "PNG/JPEG/TIFF: OpenColorIO config file (default: $OCIO, else the built-in config; "
+                           "`whitted colour --list` shows it)");
+    render_cmd->add_option("--display", render_args.display,
+                           "PNG/JPEG/TIFF: OCIO display, e.g. sRGB, 'Gamma 2.2', BT.1886, 'Display P3' "
+                           "(default: the config's default)");
+    render_cmd->add_option("--view", render_args.view,
+                           "PNG/JPEG/TIFF: OCIO view, e.g. Standard, Raw (default: the display's default)");
     render_cmd->add_flag("--stats", render_args.stats,
                          "Print the time of each stage (parse, load, BVH, render, write) and the BVH's memory");
     render_cmd->add_flag("--partial", render_args.partial,
@@ -430,11 +487,26 @@ int main(int argc, char** argv) {
     check_cmd->add_option("-t,--threads", check_options.threads, "Worker threads for Whitted (default: all cores)");
     check_cmd->add_flag("-q,--quiet", check_options.quiet, "Print only the verdict line");
 
+    std::string colour_config, colour_write;
+    bool colour_list = false;
+    CLI::App* colour_cmd = app.add_subcommand(
+        "colour", "Show the OpenColorIO displays and views, or write the built-in config for other programs");
+    colour_cmd->alias("color");
+    colour_cmd->add_flag("--list", colour_list,
+                         "Print each display and view, the colour space it writes and what that means");
+    colour_cmd->add_option("--ocio-config", colour_config,
+                           "With --list: this config (default: $OCIO, else the built-in config)");
+    colour_cmd->add_option("--write-config", colour_write,
+                           "Write the built-in config to this .ocio file (for oiiotool, Nuke, Blender, ...)");
+    colour_cmd->require_option(1, 2);
+
     std::string compare_first, compare_second;
     double compare_tolerance = 2.0, compare_fraction = 0.999, compare_max_error = 64.0;
     bool compare_clip = false;
     CLI::App* compare_cmd =
-        app.add_subcommand("compare", "Compare two images pixel by pixel (e.g. a Whitted EXR and a POV-Ray PNG)");
+        app.add_subcommand("compare",
+                           "Compare two images pixel by pixel (e.g. a Whitted EXR and a POV-Ray PNG), each first "
+                           "turned into linear Rec.709 from its colour metadata");
     compare_cmd->add_option("first", compare_first, "Image")->required()->check(CLI::ExistingFile);
     compare_cmd->add_option("second", compare_second, "Image of the same size")->required()->check(CLI::ExistingFile);
     compare_cmd->add_option("--tolerance", compare_tolerance, "Per-channel tolerance in 16-bit codes (1/65535)")
@@ -467,6 +539,7 @@ int main(int argc, char** argv) {
         std::_Exit(code);
     }
     if (*convert_cmd) return run_convert(convert_scene, convert_output);
+    if (*colour_cmd) return run_colour(colour_list, colour_config, colour_write);
     if (*compare_cmd) {
         reference::PassRule rule;
         rule.tolerance = compare_tolerance / 65535.0;

@@ -118,5 +118,18 @@ TEST(AtomicFiles, RenamesWaitForTheDirectoryLock) {
     EXPECT_EQ(entries(directory.path()), (std::vector<std::string>{"s.ini", "s.pov"}));
 }
 
+// A legal 255-byte name must have a legal temporary name too, kept in the same directory.
+TEST(AtomicFiles, TemporaryNameOfALongNameFits) {
+    const test::ScratchDirectory directory;
+    const std::filesystem::path target = directory.path() / (std::string(251, 'x') + ".png");
+    const std::filesystem::path temporary = temporary_path(target);
+    EXPECT_LE(temporary.filename().string().size(), 255u);
+    EXPECT_EQ(temporary.parent_path(), directory.path());
+    EXPECT_EQ(temporary.extension(), ".png");
+    write_files_atomically({{target, "bytes"}});
+    EXPECT_EQ(bytes_of(target), "bytes");
+    EXPECT_EQ(entries(directory.path()), std::vector<std::string>{target.filename().string()});
+}
+
 }  // namespace
 }  // namespace whitted

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
-// The built-in OpenColorIO config: the sRGB display's Standard view is the IEC 61966-2-1 curve
-// (1.055·x^(1/2.4) − 0.055 above the linear toe), Raw is the identity, and unknown names are
-// refused with a message listing what exists.
+// The built-in OpenColorIO config against closed-form values: the sRGB display's Standard view
+// is the IEC 61966-2-1 curve (1.055·x^(1/2.4) − 0.055 above the linear toe), Gamma 2.2 and
+// BT.1886 are x^(1/2.2) and x^(1/2.4), Display P3 is the sRGB curve after the published Rec.709
+// → P3-D65 matrix, every Raw view is the identity; each is recognised as what it is (the
+// encoding the files declare), and unknown names are refused with a message listing what exists.
 
 #include "whitted/output/color_management.h"
 
@@ -9,8 +11,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace whitted {
@@ -59,9 +64,9 @@ TEST_F(BuiltinConfig, UnknownDisplayListsDisplays) {
     try {
         const DisplayTransform transform("", "P3-D65", "");
         FAIL() << "an unknown display was accepted";
-    } catch (const std::runtime_error& e) {
+    } catch (const std::invalid_argument& e) {
         EXPECT_THAT(std::string(e.what()), HasSubstr("'P3-D65'"));
-        EXPECT_THAT(std::string(e.what()), HasSubstr("displays: sRGB"));
+        EXPECT_THAT(std::string(e.what()), HasSubstr("displays: sRGB, Gamma 2.2, BT.1886, Display P3"));
     }
 }
 
@@ -69,11 +74,84 @@ TEST_F(BuiltinConfig, UnknownViewListsViews) {
     try {
         const DisplayTransform transform("", "sRGB", "Filmic");
         FAIL() << "an unknown view was accepted";
-    } catch (const std::runtime_error& e) {
+    } catch (const std::invalid_argument& e) {
         EXPECT_THAT(std::string(e.what()), HasSubstr("'Filmic'"));
         EXPECT_THAT(std::string(e.what()), HasSubstr("Standard"));
         EXPECT_THAT(std::string(e.what()), HasSubstr("Raw"));
     }
+}
+
+TEST_F(BuiltinConfig, PowerLawDisplays) {
+    for (const auto& [display, gamma] : {std::pair<const char*, double>{"Gamma 2.2", 2.2}, {"BT.1886", 2.4}}) {
+        const DisplayTransform transform("", display, "Standard");
+        std::vector<float> rgb = {0.18f, 1.0f, 0.0f, 0.5f, 0.05f, 0.002f};
+        const std::vector<float> linear = rgb;
+        transform.apply(rgb.data(), rgb.size() / 3);
+        for (size_t k = 0; k < rgb.size(); ++k)
+            EXPECT_NEAR(rgb[k], std::pow(double(linear[k]), 1 / gamma), 1e-4) << display << " at " << linear[k];
+        EXPECT_EQ(transform.encoding().primaries, DisplayEncoding::Primaries::rec709) << display;
+    }
+    EXPECT_EQ(DisplayTransform("", "Gamma 2.2", "").encoding().transfer, DisplayEncoding::Transfer::gamma22);
+    EXPECT_EQ(DisplayTransform("", "BT.1886", "").encoding().transfer, DisplayEncoding::Transfer::gamma24);
+}
+
+TEST_F(BuiltinConfig, DisplayP3IsTheSrgbCurveOnP3Primaries) {
+    // Rec.709 → P3-D65 (both D65, so no adaptation), as commonly published to seven places.
+    const double to_p3[3][3] = {
+        {0.8224621, 0.1775380, 0.0000000}, {0.0331941, 0.9668058, 0.0000000}, {0.0170827, 0.0723974, 0.9105199}};
+    const DisplayTransform transform("", "Display P3", "Standard");
+    const float colours[][3] = {{0.5f, 0.2f, 0.1f}, {0.0f, 0.0f, 0.8f}, {0.18f, 0.18f, 0.18f}, {1.0f, 0.0f, 0.0f}};
+    for (const auto& c : colours) {
+        std::vector<float> rgb(c, c + 3);
+        transform.apply(rgb.data(), 1);
+        for (int k = 0; k < 3; ++k) {
+            const double p3 = to_p3[k][0] * double(c[0]) + to_p3[k][1] * double(c[1]) + to_p3[k][2] * double(c[2]);
+            EXPECT_NEAR(rgb[size_t(k)], srgb_encode(p3), 2e-4) << "channel " << k << " of " << c[0] << "," << c[1];
+        }
+    }
+    EXPECT_EQ(transform.encoding().transfer, DisplayEncoding::Transfer::srgb);
+    EXPECT_EQ(transform.encoding().primaries, DisplayEncoding::Primaries::display_p3);
+}
+
+TEST_F(BuiltinConfig, EveryRawViewIsIdentityAndDeclaredLinear) {
+    for (const char* display : {"sRGB", "Gamma 2.2", "BT.1886", "Display P3"}) {
+        const DisplayTransform transform("", display, "Raw");
+        std::vector<float> rgb = {0.18f, 0.5f, 0.9f, 0.0f, 0.001f, 0.75f};
+        const std::vector<float> linear = rgb;
+        transform.apply(rgb.data(), rgb.size() / 3);
+        for (size_t k = 0; k < rgb.size(); ++k) EXPECT_FLOAT_EQ(rgb[k], linear[k]) << display;
+        EXPECT_EQ(transform.encoding().transfer, DisplayEncoding::Transfer::linear) << display;
+        EXPECT_EQ(transform.encoding().primaries, DisplayEncoding::Primaries::rec709) << display;
+        EXPECT_EQ(transform.colorspace(), "Raw");
+    }
+}
+
+TEST_F(BuiltinConfig, WrittenConfigLoadsAndGivesTheSameValues) {
+    const std::string path = ::testing::TempDir() + "whitted-builtin-test.ocio";
+    {
+        std::FILE* file = std::fopen(path.c_str(), "w");
+        ASSERT_NE(file, nullptr);
+        const std::string text = DisplayTransform::builtin_config_text();
+        ASSERT_EQ(std::fwrite(text.data(), 1, text.size(), file), text.size());
+        std::fclose(file);
+    }
+    for (const char* display : {"sRGB", "Gamma 2.2", "BT.1886", "Display P3"}) {
+        const DisplayTransform builtin("", display, "Standard"), loaded(path, display, "Standard");
+        std::vector<float> a = {0.18f, 0.5f, 0.9f, 0.02f, 0.7f, 0.3f}, b = a;
+        builtin.apply(a.data(), 2);
+        loaded.apply(b.data(), 2);
+        for (size_t k = 0; k < a.size(); ++k) EXPECT_FLOAT_EQ(a[k], b[k]) << display;
+        EXPECT_EQ(loaded.config_name(), "whitted-builtin");
+        EXPECT_EQ(loaded.encoding().transfer, builtin.encoding().transfer) << display;
+        EXPECT_EQ(loaded.encoding().primaries, builtin.encoding().primaries) << display;
+    }
+    std::remove(path.c_str());
+}
+
+TEST_F(BuiltinConfig, UnreadableConfigIsAUsageError) {
+    EXPECT_THROW(DisplayTransform("/etc/passwd", "", ""), std::invalid_argument);
+    EXPECT_THROW(DisplayTransform("/nonexistent/config.ocio", "", ""), std::invalid_argument);
+    EXPECT_THROW(DisplayTransform("/", "", ""), std::invalid_argument);
 }
 
 }  // namespace

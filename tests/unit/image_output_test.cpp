@@ -11,12 +11,14 @@
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfStandardAttributes.h>
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <limits>
 
 #include <filesystem>
@@ -177,6 +179,55 @@ TEST(ImageOutput, FailedWriteLeavesTheOldFileAlone) {
     EXPECT_THROW(write_image(ramp(8, 8, 2.0f), path, bad), std::invalid_argument);
     EXPECT_EQ(bytes_of(path), before);
     EXPECT_EQ(entries(directory.path()), std::vector<std::string>{"keep.exr"});
+}
+
+TEST(ImageOutput, ExrDeclaresRec709Chromaticities) {
+    const test::ScratchDirectory directory;
+    const std::string path = (directory.path() / "c.exr").string();
+    write_image(ramp(2, 2, 1.0f), path, {});
+    Imf::InputFile file(path.c_str());
+    ASSERT_TRUE(Imf::hasChromaticities(file.header()));
+    const Imf::Chromaticities& c = Imf::chromaticities(file.header());
+    EXPECT_FLOAT_EQ(c.red.x, 0.64f);
+    EXPECT_FLOAT_EQ(c.red.y, 0.33f);
+    EXPECT_FLOAT_EQ(c.green.x, 0.30f);
+    EXPECT_FLOAT_EQ(c.blue.y, 0.06f);
+    EXPECT_FLOAT_EQ(c.white.x, 0.3127f);
+    EXPECT_FLOAT_EQ(c.white.y, 0.3290f);
+}
+
+// Each option that cannot apply to the format is refused before anything is rendered.
+TEST(ImageOutput, OptionsThatCannotApplyAreRefused) {
+    ::unsetenv("OCIO");  // the built-in config's displays
+    const auto refused = [](const std::string& path, const OutputOptions& options) {
+        try {
+            check_output_options(path, options);
+            return std::string();
+        } catch (const std::invalid_argument& e) {
+            return std::string(e.what());
+        }
+    };
+    OutputOptions deep;
+    deep.bit_depth = 16;
+    EXPECT_NE(refused("a.jpg", deep).find("--bit-depth 16"), std::string::npos);
+    EXPECT_NE(refused("a.exr", deep).find("--bit-depth"), std::string::npos);
+    EXPECT_EQ(refused("a.png", deep), "");
+    EXPECT_EQ(refused("a.tif", deep), "");
+    OutputOptions half;
+    half.half = true;
+    EXPECT_NE(refused("a.png", half).find("--half"), std::string::npos);
+    EXPECT_EQ(refused("a.exr", half), "");
+    OutputOptions zip;
+    zip.exr_compression = "zip";
+    EXPECT_NE(refused("a.tif", zip).find("--exr-compression"), std::string::npos);
+    OutputOptions raw;
+    raw.view = "Raw";
+    EXPECT_NE(refused("a.exr", raw).find("--view"), std::string::npos);
+    EXPECT_EQ(refused("a.png", raw), "");
+    OutputOptions display;
+    display.display = "Rec.2020";
+    EXPECT_NE(refused("a.png", display).find("displays: sRGB, Gamma 2.2, BT.1886, Display P3"), std::string::npos);
+    EXPECT_NE(refused("a.exr", display).find("--display"), std::string::npos);
 }
 
 }  // namespace

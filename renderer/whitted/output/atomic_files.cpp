@@ -130,9 +130,13 @@ void undo(const Moved& moved) {
 
 std::string temporary_path(const std::filesystem::path& target) {
     const std::filesystem::path directory = target.parent_path().empty() ? "." : target.parent_path();
-    return (directory / ("." + target.filename().string() + ".whitted-" + std::to_string(::getpid()) + ".tmp" +
-                         target.extension().string()))
-        .string();
+    const std::string suffix = ".whitted-" + std::to_string(::getpid()) + ".tmp" + target.extension().string();
+    std::string name = target.filename().string();
+    // A legal name near the 255-byte limit must not fail on the longer temporary one after
+    // the render: the name is cut short (its start is kept; the suffix still marks the file).
+    constexpr size_t most = 255;
+    if (1 + name.size() + suffix.size() > most) name.resize(most - 1 - std::min(suffix.size(), most - 1));
+    return (directory / ("." + name + suffix)).string();
 }
 
 void move_into_place(const std::string& temporary, const std::filesystem::path& target) {

@@ -3,19 +3,23 @@
 
 #include "whitted/output/atomic_files.h"
 #include "whitted/output/color_management.h"
+#include "whitted/output/icc_profile.h"
+#include "whitted/output/jpeg_file.h"
 
-#include "whitted/output/plugin.h"
 #include "whitted/output/png_file.h"
+#include "whitted/output/tiff_file.h"
 
 #include <Imath/half.h>
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfThreading.h>
 
 #include <unistd.h>
+#include <climits>
 
 #include <algorithm>
 #include <cerrno>
@@ -74,12 +78,68 @@ void check_output_path(const std::string& path) {
         throw std::invalid_argument("cannot write '" + path + "': directory '" + dir.string() + "' is not writable");
     if (std::filesystem::is_directory(p, error))
         throw std::invalid_argument("cannot write '" + path + "': it is a directory");
+    // Found here rather than when the finished image cannot be named, after the render.
+    const long name_max = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+    const size_t longest = name_max > 0 ? size_t(name_max) : size_t(NAME_MAX);
+    if (p.filename().string().size() > longest)
+        throw std::invalid_argument("cannot write '" + path + "': the file name is " +
+                                    std::to_string(p.filename().string().size()) +
+                                    " bytes long; this filesystem allows " + std::to_string(longest));
 }
 
-/// The plug-in's writer for JPEG and TIFF (8/16-bit); see plugin.h. PNG is written here (png_file.h).
-using WriteDisplayImage = std::string (*)(const std::string& format_path, const std::string& temp_path, int width,
-                                          int height, const float* rgb, int bits,
-                                          const std::vector<std::pair<std::string, std::string>>& metadata);
+namespace {
+
+bool is_jpeg(const std::string& ext) {
+    return ext == ".jpg" || ext == ".jpeg";
+}
+bool is_tiff(const std::string& ext) {
+    return ext == ".tif" || ext == ".tiff";
+}
+
+/// The checks of check_output_options that need no config.
+void check_format_options(const std::string& path, const OutputOptions& options) {
+    const std::string ext = lower_extension(path);
+    if (output_kind(path) == OutputKind::linear_exr) {
+        const auto refuse = [&](const std::string& option) {
+            throw std::invalid_argument(option + " cannot apply to '" + path +
+                                        "': an EXR holds the scene-linear floats, before any display transform; "
+                                        "write a .png, .jpg or .tif for a display-referred image");
+        };
+        if (options.bit_depth) refuse("--bit-depth");  // --half picks the EXR's precision
+        if (!options.ocio_config.empty()) refuse("--ocio-config");
+        if (!options.display.empty()) refuse("--display");
+        if (!options.view.empty()) refuse("--view");
+        return;
+    }
+    const auto refuse = [&](const std::string& option) {
+        throw std::invalid_argument(option + " cannot apply to '" + path + "': it is for .exr files only");
+    };
+    if (options.half) refuse("--half");
+    if (!options.exr_compression.empty()) refuse("--exr-compression");
+    if (is_jpeg(ext) && options.bit_depth != 0 && options.bit_depth != 8)
+        throw std::invalid_argument("--bit-depth " + std::to_string(options.bit_depth) + " cannot apply to '" + path +
+                                    "': JPEG files hold 8 bits per channel; write a .png or .tif for 16 bits");
+    if (options.bit_depth != 0 && options.bit_depth != 8 && options.bit_depth != 16)
+        throw std::invalid_argument("--bit-depth must be 8 or 16");
+}
+
+/// The config as a file records it: never a path of this machine beyond the file's name.
+std::string config_label(const DisplayTransform& display) {
+    const std::string& source = display.config_source();
+    if (source == "built-in") return "built-in (" + display.config_name() + ")";
+    const bool from_env = source.rfind("$OCIO=", 0) == 0;
+    const std::string file = std::filesystem::path(from_env ? source.substr(6) : source).filename().string();
+    return file + (from_env ? " (from $OCIO)" : "") +
+           (display.config_name().empty() ? "" : ", " + display.config_name());
+}
+
+}  // namespace
+
+void check_output_options(const std::string& path, const OutputOptions& options) {
+    check_format_options(path, options);
+    if (output_kind(path) == OutputKind::display_referred)
+        DisplayTransform(options.ocio_config, options.display, options.view);  // loads the config, finds the names
+}
 
 namespace {
 
@@ -106,6 +166,8 @@ void write_exr(const Image& image, const std::string& temp_path, bool half, Imf:
     const Imf::PixelType type = half ? Imf::HALF : Imf::FLOAT;
     for (const char* channel : {"R", "G", "B"}) header.channels().insert(channel, Imf::Channel(type));
     for (const auto& [key, value] : metadata) header.insert(key, Imf::StringAttribute(value));
+    // The standard attribute readers look for (OpenEXR's Chromaticities: Rec.709 primaries, D65).
+    Imf::addChromaticities(header, Imf::Chromaticities());
     std::vector<Imath::half> halves;
     const char* base = reinterpret_cast<const char*>(image.rgb.data());
     size_t element = sizeof(float);
@@ -124,41 +186,59 @@ void write_exr(const Image& image, const std::string& temp_path, bool half, Imf:
         file.setFrameBuffer(frame);
         file.writePixels(image.height);
     } catch (const std::exception& e) {
-        throw std::runtime_error(std::string("cannot write the EXR file: ") + e.what());
+        throw std::runtime_error(std::string("OpenEXR: ") + e.what());
+    }
+}
+
+/// write_image's work, into `temp_path`.
+void write_to(const std::string& temp_path, const Image& image, const std::string& path, const OutputOptions& options,
+              std::vector<std::pair<std::string, std::string>> metadata) {
+    const OutputKind kind = output_kind(path);
+    const std::string ext = lower_extension(path);
+    if (kind == OutputKind::linear_exr) {
+        metadata.push_back({"whitted:colorspace", "Linear Rec.709 (sRGB)"});
+        metadata.insert(metadata.end(), options.metadata.begin(), options.metadata.end());
+        write_exr(image, temp_path, options.half, exr_compression(options.exr_compression), metadata);
+    } else {
+        const DisplayTransform display(options.ocio_config, options.display, options.view);
+        const int bits = options.bit_depth ? options.bit_depth : (is_tiff(ext) ? 16 : 8);
+        metadata.push_back({"whitted:colorspace", display.colorspace()});
+        metadata.push_back({"whitted:encoding", display.encoding().description()});
+        metadata.push_back({"whitted:ocio_config", config_label(display)});
+        metadata.push_back({"whitted:display", display.display()});
+        metadata.push_back({"whitted:view", display.view()});
+        metadata.insert(metadata.end(), options.metadata.begin(), options.metadata.end());
+        if (ext == ".png") {
+            write_png(temp_path, image, display, bits, metadata);
+        } else {
+            std::vector<float> pixels = image.rgb;
+            display.apply(pixels.data(), pixels.size() / 3);
+            const std::vector<unsigned char> profile =
+                icc_profile(display.encoding(), "Whitted: " + display.display() + " / " + display.view() + " (" +
+                                                    display.colorspace() + ")");
+            if (is_jpeg(ext))
+                write_jpeg(temp_path, image.width, image.height, pixels.data(), metadata, profile);
+            else
+                write_tiff(temp_path, image.width, image.height, pixels.data(), bits, metadata, profile);
+        }
     }
 }
 
 }  // namespace
 
 void write_image(const Image& image, const std::string& path, const OutputOptions& options) {
-    const OutputKind kind = output_kind(path);
-    const std::string ext = lower_extension(path);
-    std::vector<std::pair<std::string, std::string>> metadata{{"Software", "Whitted 0.1.0"}};
-    metadata.insert(metadata.end(), options.metadata.begin(), options.metadata.end());
+    check_format_options(path, options);
+    std::vector<std::pair<std::string, std::string>> metadata{{"Software", "Whitted " WHITTED_VERSION}};
 
     TemporaryFile temporary(path);
-    if (kind == OutputKind::linear_exr) {
-        metadata.push_back({"whitted:colorspace", "Linear Rec.709 (sRGB), scene-referred"});
-        write_exr(image, temporary.path(), options.half, exr_compression(options.exr_compression), metadata);
-    } else {
-        const DisplayTransform display(options.ocio_config, options.display, options.view);
-        const bool is_tiff = ext == ".tif" || ext == ".tiff";
-        const int bits = options.bit_depth ? options.bit_depth : (is_tiff ? 16 : 8);
-        if ((ext == ".jpg" || ext == ".jpeg") && bits != 8)
-            throw std::invalid_argument("JPEG files hold 8 bits per channel only");
-        metadata.push_back(
-            {"whitted:colorspace", display.display() + " / " + display.view() + " (" + display.config_source() + ")"});
-        if (ext == ".png") {
-            write_png(temporary.path(), image, display, bits, metadata);
-        } else {
-            std::vector<float> pixels = image.rgb;
-            display.apply(pixels.data(), pixels.size() / 3);
-            const auto write =
-                reinterpret_cast<WriteDisplayImage>(image_io_plugin_symbol("whitted_write_display_image"));
-            const std::string error =
-                write(path, temporary.path(), image.width, image.height, pixels.data(), bits, metadata);
-            if (!error.empty()) throw std::runtime_error("cannot write '" + path + "': " + error);
-        }
+    // Every writer's failure as one message naming the file (the temporary is removed by
+    // `temporary`; the existing file is untouched).
+    try {
+        write_to(temporary.path(), image, path, options, metadata);
+    } catch (const std::invalid_argument&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw std::runtime_error("cannot write '" + path + "': " + e.what());
     }
     temporary.commit(path);
 }

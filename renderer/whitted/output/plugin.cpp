@@ -34,7 +34,7 @@ void* load_plugin() {
         tried += "\n  " + path.string() + " (" + dlerror() + ")";
     }
     throw std::runtime_error(std::string("cannot load the OpenImageIO plug-in ") + plugin_file +
-                             " (needed for PNG/JPEG/TIFF and `whitted check`); tried:" + tried);
+                             " (needed for `whitted check` and `whitted compare`); tried:" + tried);
 }
 
 }  // namespace

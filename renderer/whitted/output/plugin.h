@@ -5,10 +5,10 @@
 
 namespace whitted {
 
-/// Code that needs OpenImageIO (PNG/JPEG/TIFF output, reading images, `whitted check`) lives in
+/// Code that needs OpenImageIO (reading images: `whitted check` and `whitted compare`) lives in
 /// a plug-in, lib/libwhitted_oiio.so, loaded on first use. Linking OpenImageIO into the program
 /// would cost every run about 0.2 s of start-up (it pulls in ~250 shared libraries), most of a
-/// small render's time; an EXR render never loads it.
+/// small render's time; a render never loads it.
 ///
 /// Returns the address of `name` in the plug-in, loading it from $WHITTED_PLUGIN_DIR, else from
 /// ../lib beside the running program, else from the build tree. Throws std::runtime_error

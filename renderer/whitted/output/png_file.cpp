@@ -6,12 +6,15 @@
 
 #include "whitted/output/png_file.h"
 
+#include "whitted/output/chromaticities.h"
+
 #include <png.h>
 #include <tbb/parallel_for.h>
 #include <zlib.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -30,16 +33,40 @@ struct PngJob {
     size_t idat_size;
     png_text* texts;
     int text_count;
+    DisplayEncoding encoding;
     char error[256];
 };
 
 extern "C" void on_png_error(png_structp png, png_const_charp message) {
+    const int reason = errno;  // libpng's "Write Error" does not say why (a full disk, a quota)
     auto* job = static_cast<PngJob*>(png_get_error_ptr(png));
-    std::snprintf(job->error, sizeof job->error, "%s", message);
+    if (reason)
+        std::snprintf(job->error, sizeof job->error, "%s (%s)", message, std::strerror(reason));
+    else
+        std::snprintf(job->error, sizeof job->error, "%s", message);
     png_longjmp(png, 1);
 }
 
 extern "C" void on_png_warning(png_structp, png_const_charp) {}  // nothing a user could act on
+
+/// sRGB, gAMA and cHRM, what readers without cICP go by: an sRGB chunk (with the gAMA and
+/// cHRM the PNG specification asks to go with it) for the sRGB curve on Rec.709 primaries,
+/// else gAMA with the curve's exponent (1.0 for linear values) and cHRM with the primaries.
+void set_colour_chunks(png_structp png, png_infop info, const DisplayEncoding& encoding) {
+    if (!encoding.known()) return;
+    using T = DisplayEncoding::Transfer;
+    if (encoding.transfer == T::srgb && encoding.primaries == DisplayEncoding::Primaries::rec709) {
+        png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+        return;
+    }
+    // gAMA stores the encoding exponent (1/decoding gamma) times 100000; the sRGB curve on
+    // other primaries is written as its usual approximation, 1/2.2.
+    const double decoding_gamma = encoding.transfer == T::linear ? 1.0 : encoding.transfer == T::gamma24 ? 2.4 : 2.2;
+    png_set_gAMA_fixed(png, info, png_fixed_point(std::lround(100000.0 / decoding_gamma)));
+    const Chromaticities& c = encoding.primaries == DisplayEncoding::Primaries::display_p3 ? display_p3_chromaticities
+                                                                                           : rec709_chromaticities;
+    png_set_cHRM(png, info, c.white[0], c.white[1], c.red[0], c.red[1], c.green[0], c.green[1], c.blue[0], c.blue[1]);
+}
 
 bool run(PngJob& job) {
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &job, on_png_error, on_png_warning);
@@ -57,7 +84,23 @@ bool run(PngJob& job) {
     png_set_IHDR(png, info, png_uint_32(job.width), png_uint_32(job.height), job.bits, PNG_COLOR_TYPE_RGB,
                  PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     if (job.text_count > 0) png_set_text(png, info, job.texts, job.text_count);
+    set_colour_chunks(png, info, job.encoding);
     png_write_info(png, info);
+    // cICP (PNG third edition; libpng 1.6.39 has no setter, so written as a chunk of our own,
+    // which must come before IDAT): the exact code points, which readers that know it prefer.
+    if (job.encoding.known()) {
+        using T = DisplayEncoding::Transfer;
+        const T t = job.encoding.transfer;
+        // ITU-T H.273: primaries 1 = BT.709, 12 = P3-D65; transfer 13 = sRGB, 8 = linear,
+        // 4 = gamma 2.2, 1 = BT.709 (shown by a BT.1886 display); matrix 0 = RGB; full range.
+        const png_byte cicp[4] = {png_byte(job.encoding.primaries == DisplayEncoding::Primaries::display_p3 ? 12 : 1),
+                                  png_byte(t == T::srgb      ? 13
+                                           : t == T::linear  ? 8
+                                           : t == T::gamma22 ? 4
+                                                             : 1),
+                                  0, 1};
+        png_write_chunk(png, reinterpret_cast<png_const_bytep>("cICP"), cicp, sizeof cicp);
+    }
     // The image data was compressed beforehand (compress_rows); libpng frames it.
     constexpr size_t most_per_chunk = size_t(1) << 24;
     for (size_t at = 0; at < job.idat_size; at += most_per_chunk)
@@ -178,7 +221,9 @@ void write_png(const std::string& path, const Image& linear, const DisplayTransf
     std::FILE* file = std::fopen(path.c_str(), "wb");
     if (!file) throw std::runtime_error("cannot open '" + path + "' for writing: " + std::strerror(errno));
     const std::vector<unsigned char> idat = compress_rows(rows.data(), row_bytes, height, bits);
-    PngJob job{file, width, height, bits, idat.data(), idat.size(), texts.data(), int(texts.size()), {}};
+    PngJob job{file, width, height, bits, idat.data(), idat.size(), texts.data(), int(texts.size()), display.encoding(),
+               {}};
+    errno = 0;
     const bool wrote = run(job);
     const bool closed = std::fclose(file) == 0;
     if (!wrote) throw std::runtime_error(std::string("libpng: ") + job.error);

@@ -1,0 +1,118 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""Usage checked before any work (docs/colour.md): every option that cannot apply to the output
+format, an unknown display or view, an unreadable OCIO config, an output that is an input file
+and an output name too long for the filesystem are errors with exit 2, in the house form, in
+under 0.1 s, and before the scene is read: the scene given here does not parse, so a message
+about the scene would mean the check came too late. Nothing is written.
+
+Usage: usage_test.py WHITTED EXAMPLES_DIR"""
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+whitted, examples = sys.argv[1], sys.argv[2]
+failures = []
+
+
+def run(args, cwd):
+    env = dict(os.environ)
+    env.pop("OCIO", None)  # the built-in config's names are expected below
+    best, result = None, None
+    # The best of three, so that a loaded machine (ctest -j) does not make a fast check look slow.
+    for _ in range(3):
+        start = time.monotonic()
+        result = subprocess.run([whitted] + args, cwd=cwd, env=env, capture_output=True, text=True, timeout=60)
+        elapsed = time.monotonic() - start
+        best = elapsed if best is None else min(best, elapsed)
+    return result, best
+
+
+def expect_usage_error(args, cwd, fragments, label):
+    result, seconds = run(args, cwd)
+    problems = []
+    if result.returncode != 2:
+        problems.append(f"exit {result.returncode}, not 2")
+    if not result.stderr.startswith("whitted: error: "):
+        problems.append("not in the 'whitted: error:' form")
+    for fragment in fragments:
+        if fragment not in result.stderr:
+            problems.append(f"message lacks {fragment!r}")
+    if seconds >= 0.1:
+        problems.append(f"took {seconds:.3f} s (limit 0.1 s)")
+    if problems:
+        failures.append(f"{label}: {'; '.join(problems)}\n    stderr: {result.stderr.strip()}")
+    else:
+        print(f"ok   {label}: exit 2 in {seconds * 1000:.0f} ms: {result.stderr.strip()[:110]}")
+
+
+with tempfile.TemporaryDirectory() as work:
+    bad_scene = os.path.join(work, "unparsable.yaml")
+    with open(bad_scene, "w") as f:
+        f.write("version: 1\ncamera: [this is not a camera\n")
+    cases = [
+        (["-o", "a.jpg", "--bit-depth", "16"], ["--bit-depth 16", "a.jpg", "8 bits"]),
+        (["-o", "a.jpeg", "--bit-depth", "16"], ["--bit-depth 16"]),
+        (["-o", "a.png", "--half"], ["--half", ".exr files only"]),
+        (["-o", "a.tif", "--exr-compression", "zip"], ["--exr-compression"]),
+        (["-o", "a.jpg", "--exr-compression", "none"], ["--exr-compression"]),
+        (["-o", "a.exr", "--bit-depth", "16"], ["--bit-depth", "scene-linear"]),
+        (["-o", "a.exr", "--view", "Raw"], ["--view", "scene-linear"]),
+        (["-o", "a.exr", "--display", "sRGB"], ["--display"]),
+        (["-o", "a.exr", "--ocio-config", "/etc/passwd"], ["--ocio-config"]),
+        (["-o", "a.png", "--display", "foo"], ["'foo'", "displays: sRGB, Gamma 2.2, BT.1886, Display P3"]),
+        (["-o", "a.png", "--display", "Display P3", "--view", "Filmic"], ["'Filmic'", "views: Standard, Raw"]),
+        (["-o", "a.png", "--view", "Log"], ["'Log'", "views: Standard, Raw"]),
+        (["-o", "a.tif", "--ocio-config", "/etc/passwd"], ["/etc/passwd", "cannot load the OpenColorIO config"]),
+        (["-o", "a.png", "--ocio-config", os.path.join(work, "missing.ocio")], ["no such file"]),
+        (["-o", "a.png", "--ocio-config", work], ["it is a directory"]),
+        (["-o", "a.webp"], ["unknown image type"]),
+        (["-o", "x" * 252 + ".png"], ["256 bytes long", "allows 255"]),
+    ]
+    for extra, fragments in cases:
+        expect_usage_error(["render", bad_scene] + extra, work, fragments, " ".join(a[:40] for a in extra))
+
+    # The output is the scene, by the same name, another name, and a link.
+    scene = os.path.join(work, "s.png")
+    shutil.copy(os.path.join(examples, "lecture", "01-lambertian-sphere.yaml"), scene)
+    os.symlink("s.png", os.path.join(work, "link.png"))
+    before = open(scene, "rb").read()
+    for output in ["s.png", "./s.png", os.path.join(work, "s.png"), "link.png"]:
+        expect_usage_error(["render", "s.png", "-o", output], work, ["it is the scene file"], f"-o {output} (the scene)")
+    if open(scene, "rb").read() != before:
+        failures.append("the scene file was changed")
+
+    # The output is one of the scene's mesh files (a hard link to it: the same file).
+    meshes = os.path.join(work, "meshes")
+    shutil.copytree(os.path.join(examples, "meshes"), meshes)
+    os.link(os.path.join(meshes, "octahedron.obj"), os.path.join(meshes, "out.png"))
+    result, _ = run(["render", "meshes.yaml", "-o", "out.png"], meshes)
+    if result.returncode != 2 or "it is the mesh file" not in result.stderr:
+        failures.append(f"output over a mesh file: exit {result.returncode}: {result.stderr.strip()}")
+    else:
+        print(f"ok   output over a mesh file: {result.stderr.strip()}")
+
+    # A legal 240-byte name renders (its temporary name is longer than 255 bytes uncut).
+    long_name = "y" * 236 + ".png"
+    result, _ = run(["render", "s.png", "-q", "-o", long_name], work)
+    if result.returncode != 0 or not os.path.isfile(os.path.join(work, long_name)):
+        failures.append(f"a 240-byte output name: exit {result.returncode}: {result.stderr.strip()}")
+    else:
+        print("ok   a 240-byte output name renders")
+    leftovers = [n for n in os.listdir(work) if ".whitted-" in n]
+    if leftovers:
+        failures.append(f"temporary files left: {leftovers}")
+    for name in ["a.jpg", "a.jpeg", "a.png", "a.tif", "a.exr", "a.webp"]:
+        if os.path.exists(os.path.join(work, name)):
+            failures.append(f"{name} was written by a refused command")
+
+    # `whitted colour` refuses what it cannot do, in the same way.
+    expect_usage_error(["colour", "--list", "--ocio-config", "/etc/passwd"], work, ["/etc/passwd"], "colour --list bad config")
+    expect_usage_error(["colour", "--ocio-config", "x.ocio"], work, ["--ocio-config goes with --list"], "colour no --list")
+
+for failure in failures:
+    print("FAIL " + failure)
+sys.exit(1 if failures else 0)
