@@ -87,8 +87,12 @@ void print_table(const std::string& scene_path, const CheckResult& r, const Chec
     out +=
         fmt::format("whitted check {}: {}x{}, {} sample(s)/pixel, compared at exposure {:g}{}\n", scene_path, c.width,
                     c.height, r.samples * r.samples, r.exposure, r.exposure != 1 ? " (scene values above 1)" : "");
-    out += fmt::format("  Whitted {:.3f}s, POV-Ray {:.2f}s ({} run{}, {})\n", r.whitted_seconds, r.povray_seconds,
-                       r.povray_runs, r.povray_runs == 1 ? "" : "s", r.povray_program);
+    if (!options.povray_image.empty())
+        out += fmt::format("  Whitted {:.3f}s, POV-Ray not run (stored image {}, exposure given)\n", r.whitted_seconds,
+                           options.povray_image);
+    else
+        out += fmt::format("  Whitted {:.3f}s, POV-Ray {:.2f}s ({} run{}, {})\n", r.whitted_seconds, r.povray_seconds,
+                           r.povray_runs, r.povray_runs == 1 ? "" : "s", r.povray_program);
     out += fmt::format("  max error    {:.3e}  ({} codes of 65535; cap {:g})\n", c.max_error, format_codes(c.max_error),
                        rule.max_error * 65535);
     out +=
@@ -147,7 +151,9 @@ CheckResult run_check(const std::string& scene_path, const CheckOptions& options
     if (options.exit_at_once) options.exit_at_once->store(false);
     throw_if_cancelled(options);
 
-    // 2. Where POV-Ray's files go: the report directory (kept), else a temporary one.
+    // 2. Where POV-Ray's files go: the report directory (kept), else a temporary one. With a
+    // stored POV-Ray image there are none; only a report is written.
+    const bool stored = !options.povray_image.empty();
     std::optional<TemporaryDirectory> temporary;
     fs::path work;
     if (!options.report_dir.empty()) {
@@ -157,7 +163,7 @@ CheckResult run_check(const std::string& scene_path, const CheckOptions& options
         if (error || !fs::is_directory(work))
             throw std::runtime_error("cannot create the report directory '" + work.string() +
                                      "': " + (error ? error.message() : "not a directory"));
-    } else {
+    } else if (!stored) {
         temporary.emplace("whitted-check-");
         work = temporary->path();
     }
@@ -168,9 +174,23 @@ CheckResult run_check(const std::string& scene_path, const CheckOptions& options
     // 3. POV-Ray, always into a linear 16-bit PNG (1/65535 steps): scenes brighter than 1 are
     // darkened by a power of two (lights, ambient light and background; the image is linear in
     // them) instead of using POV-Ray's half-float EXR, whose steps are 2^-11 relative.
-    double exposure = exposure_for(max_value(ours));
+    double exposure = stored ? options.exposure : exposure_for(max_value(ours));
     Image theirs_full;
-    for (int attempt = 0;; ++attempt) {
+    bool stored_clipped = false;
+    if (stored) {
+        // The same size, channels and clipping rules as for a live POV-Ray. Clipping here means
+        // the reference was made at another exposure than the one given (or ours got brighter):
+        // a failure, since the clipped pixels cannot be compared.
+        result.pov_file = result.ini_file = "";
+        result.povray_image = options.povray_image;
+        result.povray_program = "none: stored image " + options.povray_image;
+        const ImageShape shape = read_image_shape(options.povray_image);
+        result.failures = shape_mismatches({ours.width * n, ours.height * n, 3}, shape);
+        theirs_full = read_linear_image(options.povray_image);
+        stored_clipped =
+            result.failures.empty() && povray_clipped(theirs_full, ours, n, exposure, options.rule.tolerance);
+    }
+    for (int attempt = 0; !stored; ++attempt) {
         pov::ConvertOptions convert;
         convert.exposure = exposure;
         convert.hdr_output = false;
@@ -209,6 +229,9 @@ CheckResult run_check(const std::string& scene_path, const CheckOptions& options
         theirs = downsample_box(theirs_full, n);
         result.comparison = compare_images(ours_exposed, theirs, options.rule.tolerance, options.worst_count);
         result.failures = failed_rules(result.comparison, options.rule, "Whitted's image", "POV-Ray's");
+        if (stored_clipped)
+            result.failures.push_back(fmt::format(
+                "clipped (the stored POV-Ray image is 65535 where Whitted's is below 1 at exposure {:g})", exposure));
     }
     result.passed = result.failures.empty();
     throw_if_cancelled(options);

@@ -22,6 +22,12 @@ struct CheckOptions {
     size_t worst_count = 10;  ///< pixels listed by the report
     int threads = 0;
     bool quiet = false;
+    /// When set, POV-Ray is not run: this stored POV-Ray image (its linear 16-bit PNG of the
+    /// converted scene, n·W × n·H for image.samples n) is compared instead, at `exposure`, the
+    /// exposure it was rendered with (`whitted check` prints and reports it). The image tier
+    /// uses this to check against POV-Ray without POV-Ray installed (tests/image/README.md).
+    std::string povray_image;
+    double exposure = 1;  ///< only with povray_image
     /// Set (by a signal handler) to stop: POV-Ray is ended and run_check throws Interrupted.
     const std::atomic<bool>* cancel = nullptr;
     /// While true a signal may end the program at once, since nothing exists to clean up yet;

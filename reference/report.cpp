@@ -323,8 +323,14 @@ code { font-size: .95em; }
 
     h += "<h2>Reproduce</h2>\n<pre>";
     h += html_escape("whitted render " + shell_quote(scene_abs) + " -o ours.exr\n");
-    h += html_escape("cd " + shell_quote(dir_abs) + " && HOME=$(mktemp -d) povray " + r.ini_file + "\n");
-    h += html_escape("whitted check " + shell_quote(scene_abs) + " --report " + shell_quote(dir_abs) +
+    // With a stored POV-Ray image (check --povray-image) there is no .ini here to run POV-Ray on.
+    const std::string stored = options.povray_image.empty()
+                                   ? std::string()
+                                   : fmt::format(" --povray-image {} --exposure {:g}",
+                                                 shell_quote(fs::absolute(options.povray_image).string()), r.exposure);
+    if (stored.empty())
+        h += html_escape("cd " + shell_quote(dir_abs) + " && HOME=$(mktemp -d) povray " + r.ini_file + "\n");
+    h += html_escape("whitted check " + shell_quote(scene_abs) + " --report " + shell_quote(dir_abs) + stored +
                      fmt::format(" --tolerance {:g} --min-fraction {:g} --max-error {:g}", tolerance_codes,
                                  options.rule.required_fraction, options.rule.max_error * 65535) +
                      "\n");

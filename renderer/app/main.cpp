@@ -27,6 +27,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -486,6 +487,17 @@ int main(int argc, char** argv) {
         ->check(CLI::NonNegativeNumber);
     check_cmd->add_option("-t,--threads", check_options.threads, "Worker threads for Whitted (default: all cores)");
     check_cmd->add_flag("-q,--quiet", check_options.quiet, "Print only the verdict line");
+    CLI::Option* povray_image_option =
+        check_cmd
+            ->add_option("--povray-image", check_options.povray_image,
+                         "Do not run POV-Ray: compare with this stored POV-Ray 16-bit PNG of the converted scene "
+                         "(samples*W x samples*H), made at --exposure")
+            ->check(CLI::ExistingFile);
+    check_cmd
+        ->add_option("--exposure", check_options.exposure,
+                     "With --povray-image: the exposure it was rendered at (a power of two <= 1; check prints it)")
+        ->needs(povray_image_option)
+        ->check(CLI::Range(std::numeric_limits<double>::min(), 1.0));
 
     std::string colour_config, colour_write;
     bool colour_list = false;

@@ -1,6 +1,10 @@
 // SPDX-License-Identifier: MIT
-// whitted::render: tiles run in any order on any number of threads, yet every pixel depends
-// only on the scene, so the image must be bit-identical for 1, 2 and 3 threads.
+// whitted::render: tiles run in any order on any number of threads, and the BVH may be built
+// on any number of threads, yet every pixel depends only on the scene, so the image must be
+// bit-identical for every combination; with one sample per pixel (packets of 4×4 pixels,
+// render_block_single_sample) and with n×n samples (render_pixel) alike. Separate processes,
+// other thread counts and every Embree instruction set: tests/isa/isa_identical.py. Packets
+// against single rays on random rays: accelerator_test.cpp.
 
 #include "whitted/render/accelerator.h"
 #include "whitted/render/renderer.h"
@@ -16,67 +20,102 @@
 namespace whitted {
 namespace {
 
-// Several tiles (16-pixel tiles over 41×23), supersampling, mirrors, shadows, and every shape kind.
-const std::string scene_text = test::join_lines({
-    "camera: {eye: [0.3, 1.5, 6], look_at: [0, 0.2, 0], fov: 55}",
-    "image: {width: 41, height: 23, background: [0.1, 0.2, 0.3], samples: 2}",
-    "render: {max_depth: 4}",
-    "ambient: [0.9, 1, 1.1]",
-    "lights:",
-    "  - {type: point, position: [-4, 5, 3], intensity: [1, 0.9, 0.8]}",
-    "  - {type: directional, direction: [1, -1, -0.5], intensity: 0.4}",
-    "materials:",
-    "  shiny: {ka: 0.05, kd: [0.6, 0.3, 0.2], ks: 0.5, p: 40, km: 0.3}",
-    "  matte: {ka: [0.02, 0.04, 0.06], kd: [0.2, 0.4, 0.6], ks: [0.3, 0.1, 0.0], p: 8, highlight: phong}",
-    "  floor: {ka: 0.05, kd: 0.5, km: 0.5}",
-    "objects:",
-    "  - {type: sphere, center: [-1, 0.2, 0], radius: 1, material: shiny}",
-    "  - {type: box, min: [0.5, -1, -1], max: [2, 0.5, 0.5], material: matte,",
-    "     transform: [{rotate: {axis: [0, 1, 0], angle: 25}}]}",
-    "  - {type: triangle, vertices: [[-2, -1, -2], [2, -1, -2], [0, 2, -2.5]], material: matte}",
-    "  - {type: plane, point: [0, -1, 0], normal: [0, 1, 0], material: floor}",
-});
+// Several tiles (16-pixel tiles over 41×23: the last column and row of tiles, and of 4×4
+// packets, are partly filled), mirrors, shadows, and every shape kind; `samples` per pixel.
+std::string scene_text(int samples) {
+    return test::join_lines({
+        "camera: {eye: [0.3, 1.5, 6], look_at: [0, 0.2, 0], fov: 55}",
+        "image: {width: 41, height: 23, background: [0.1, 0.2, 0.3], samples: " + std::to_string(samples) + "}",
+        "render: {max_depth: 4}",
+        "ambient: [0.9, 1, 1.1]",
+        "lights:",
+        "  - {type: point, position: [-4, 5, 3], intensity: [1, 0.9, 0.8]}",
+        "  - {type: directional, direction: [1, -1, -0.5], intensity: 0.4}",
+        "materials:",
+        "  shiny: {ka: 0.05, kd: [0.6, 0.3, 0.2], ks: 0.5, p: 40, km: 0.3}",
+        "  matte: {ka: [0.02, 0.04, 0.06], kd: [0.2, 0.4, 0.6], ks: [0.3, 0.1, 0.0], p: 8, highlight: phong}",
+        "  floor: {ka: 0.05, kd: 0.5, km: 0.5}",
+        "objects:",
+        "  - {type: sphere, center: [-1, 0.2, 0], radius: 1, material: shiny}",
+        "  - {type: box, min: [0.5, -1, -1], max: [2, 0.5, 0.5], material: matte,",
+        "     transform: [{rotate: {axis: [0, 1, 0], angle: 25}}]}",
+        "  - {type: triangle, vertices: [[-2, -1, -2], [2, -1, -2], [0, 2, -2.5]], material: matte}",
+        "  - {type: mesh, material: shiny, vertices: [[-2, 1.5, -1], [-1, 2.5, -1.5], [0, 1.5, -1], [-1, 1, -0.5]],",
+        "     triangles: [[0, 1, 2], [0, 2, 3]]}",
+        "  - {type: plane, point: [0, -1, 0], normal: [0, 1, 0], material: floor}",
+    });
+}
 
-TEST(Render, ImageIsBitIdenticalForOneTwoAndThreeThreads) {
-    const Scene scene = test::scene_from(scene_text);
-    const Accelerator accelerator(scene);
+bool same_pixels(const Image& a, const Image& b) {
+    return a.rgb.size() == b.rgb.size() && std::memcmp(a.rgb.data(), b.rgb.data(), a.rgb.size() * sizeof(float)) == 0;
+}
+
+class RenderPerSamples : public testing::TestWithParam<int> {};
+
+// The reference: a BVH built on 1 thread, rendered on 1. Every other pair of (BVH build
+// threads, render threads), each BVH a new Accelerator in this one process, gives the same
+// bytes. Embree's `threads=N` limits the whole process's TBB workers while its device exists,
+// so the reference's BVH is gone before the others are built, and with the 1-thread BVH the
+// renders run on one worker whatever they ask; with the 2- and 3-thread BVHs they are parallel.
+TEST_P(RenderPerSamples, ImageIsBitIdenticalForEveryBuildAndRenderThreadCount) {
+    const int samples = GetParam();
+    const Scene scene = test::scene_from(scene_text(samples));
+    ASSERT_EQ(scene.samples, samples);
     RenderOptions options;
     options.threads = 1;
-    const RenderResult one = render(scene, accelerator, options);
+    RenderResult one;
+    {
+        const Accelerator first(scene, 1);
+        one = render(scene, first, options);
+    }
     ASSERT_FALSE(one.cancelled);
     ASSERT_EQ(one.image.rgb.size(), size_t(41) * 23 * 3);
     // A constant image would make the comparison meaningless.
     const std::set<float> distinct(one.image.rgb.begin(), one.image.rgb.end());
     ASSERT_GT(distinct.size(), 100u);
+    EXPECT_EQ(one.rays.camera, uint64_t(41) * 23 * samples * samples);
 
-    for (const int threads : {2, 3}) {
-        options.threads = threads;
-        const RenderResult other = render(scene, accelerator, options);
-        ASSERT_EQ(other.image.rgb.size(), one.image.rgb.size());
-        EXPECT_EQ(std::memcmp(other.image.rgb.data(), one.image.rgb.data(), one.image.rgb.size() * sizeof(float)), 0)
-            << threads << " threads";
-        EXPECT_EQ(other.rays.total(), one.rays.total()) << threads << " threads";
+    for (const int build_threads : {1, 2, 3}) {
+        const Accelerator accelerator(scene, build_threads);  // a new BVH: only the scene is shared
+        for (const int threads : {1, 2, 3}) {
+            if (build_threads == 1 && threads == 1) continue;
+            options.threads = threads;
+            const RenderResult other = render(scene, accelerator, options);
+            EXPECT_TRUE(same_pixels(other.image, one.image))
+                << "BVH built on " << build_threads << " thread(s), rendered on " << threads;
+            EXPECT_EQ(other.rays.total(), one.rays.total()) << build_threads << "/" << threads << " threads";
+        }
     }
 }
 
-// The tiled render stores exactly what render_pixel computes, rounded to float, rows from the top.
-TEST(Render, ImageHoldsRenderPixelValues) {
-    const Scene scene = test::scene_from(scene_text);
-    const Accelerator accelerator(scene);
+// The tiled render stores exactly what render_pixel computes, rounded to float, rows from the
+// top: for every pixel, so with one sample the 4×4 packets (partly filled at the right and
+// bottom edges) are proven against one pixel at a time.
+TEST_P(RenderPerSamples, EveryPixelHoldsTheRenderPixelValue) {
+    const int samples = GetParam();
+    const Scene scene = test::scene_from(scene_text(samples));
+    const Accelerator accelerator(scene, 2);
     RenderOptions options;
     options.threads = 2;
     const RenderResult result = render(scene, accelerator, options);
     const LectureShading shading(scene, accelerator);
-    for (const auto& [i, j] : {std::pair{0, 0}, std::pair{40, 0}, std::pair{20, 11}, std::pair{17, 22}}) {
-        RayCounts counts;
-        const Color c = render_pixel(scene, shading, i, j, counts);
-        const float* stored = result.image.pixel(i, j);
-        EXPECT_EQ(stored[0], float(c.x)) << i << "," << j;
-        EXPECT_EQ(stored[1], float(c.y)) << i << "," << j;
-        EXPECT_EQ(stored[2], float(c.z)) << i << "," << j;
-        EXPECT_EQ(counts.camera, 4u);  // samples: 2 → a 2×2 grid
-    }
+    int differing = 0;
+    for (int j = 0; j < scene.height; ++j)
+        for (int i = 0; i < scene.width; ++i) {
+            RayCounts counts;
+            const Color c = render_pixel(scene, shading, i, j, counts);
+            const float* stored = result.image.pixel(i, j);
+            const bool same = stored[0] == float(c.x) && stored[1] == float(c.y) && stored[2] == float(c.z);
+            if (!same && ++differing <= 5) ADD_FAILURE() << "pixel " << i << "," << j << " differs";
+            EXPECT_EQ(counts.camera, uint64_t(samples * samples));  // an n×n grid
+        }
+    EXPECT_EQ(differing, 0);
 }
+
+INSTANTIATE_TEST_SUITE_P(OneAndNxN, RenderPerSamples, testing::Values(1, 2, 3),
+                         [](const testing::TestParamInfo<int>& samples_info) {
+                             return "samples" + std::to_string(samples_info.param);
+                         });
 
 // --stats reports Embree's memory: a BVH over a few thousand triangles holds tens of kilobytes
 // at least (more than the triangles' own 36 bytes each), and the build's peak is no less.
