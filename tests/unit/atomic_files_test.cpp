@@ -10,6 +10,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -129,6 +130,27 @@ TEST(AtomicFiles, TemporaryNameOfALongNameFits) {
     write_files_atomically({{target, "bytes"}});
     EXPECT_EQ(bytes_of(target), "bytes");
     EXPECT_EQ(entries(directory.path()), std::vector<std::string>{target.filename().string()});
+}
+
+// A run killed with SIGKILL between naming its finished file and moving it leaves
+// `.NAME.whitted-PID.tmp.EXT`; the next write of NAME removes it when PID is gone, and leaves a
+// live process's (pid 1 here) and lookalikes alone.
+TEST(AtomicFiles, NextWriteRemovesAKilledRunsTemporary) {
+    const test::ScratchDirectory directory;
+    const pid_t child = ::fork();
+    if (child == 0) ::_exit(0);
+    ASSERT_GT(child, 0);
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);  // reaped: no process has this pid now
+    const std::string dead = ".x.pov.whitted-" + std::to_string(child) + ".tmp.pov";
+    const std::string live = ".x.pov.whitted-1.tmp.pov";
+    const std::string lookalike = ".x.pov.whitted-" + std::to_string(child) + ".tmp.pov.bak";
+    for (const std::string& name : {dead, live, lookalike}) write_files_atomically({{directory.path() / name, "left"}});
+    write_files_atomically({{directory.path() / "x.pov", "new"}});
+    EXPECT_EQ(bytes_of(directory.path() / "x.pov"), "new");
+    std::vector<std::string> expected{live, lookalike, "x.pov"};
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(entries(directory.path()), expected);
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
 #include "whitted/output/atomic_files.h"
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -126,20 +128,49 @@ void undo(const Moved& moved) {
     // Else a symlink or other non-file was replaced by a rename: it cannot be brought back.
 }
 
-}  // namespace
-
-std::string temporary_path(const std::filesystem::path& target) {
-    const std::filesystem::path directory = target.parent_path().empty() ? "." : target.parent_path();
-    const std::string suffix = ".whitted-" + std::to_string(::getpid()) + ".tmp" + target.extension().string();
+/// The temporary name temporary_path gives `target` in process `pid`.
+std::string temporary_name(const std::filesystem::path& target, long pid) {
+    const std::string suffix = ".whitted-" + std::to_string(pid) + ".tmp" + target.extension().string();
     std::string name = target.filename().string();
     // A legal name near the 255-byte limit must not fail on the longer temporary one after
     // the render: the name is cut short (its start is kept; the suffix still marks the file).
     constexpr size_t most = 255;
     if (1 + name.size() + suffix.size() > most) name.resize(most - 1 - std::min(suffix.size(), most - 1));
-    return (directory / ("." + name + suffix)).string();
+    return "." + name + suffix;
+}
+
+/// SIGKILL cannot be caught, and between naming a finished file and moving it into place (or
+/// between swapping the previous file out and deleting it) a killed process leaves its
+/// temporary behind. The next write of the same target removes those whose process is gone,
+/// so they never pile up; a live process's are left alone, as is anything that merely looks
+/// similar (the name must be exactly what temporary_path gave that process).
+void remove_abandoned_temporaries(const std::filesystem::path& target) {
+    const std::filesystem::path directory = target.parent_path().empty() ? "." : target.parent_path();
+    const std::string marker = ".whitted-";
+    DIR* listing = ::opendir(directory.c_str());
+    if (!listing) return;
+    while (const dirent* entry = ::readdir(listing)) {
+        const std::string name = entry->d_name;
+        const size_t at = name.rfind(marker);
+        if (name.empty() || name[0] != '.' || at == std::string::npos) continue;
+        char* end = nullptr;
+        const long pid = std::strtol(name.c_str() + at + marker.size(), &end, 10);
+        if (pid <= 0 || pid == ::getpid() || name != temporary_name(target, pid)) continue;
+        if (::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;  // still running (or not ours to ask)
+        ::unlinkat(::dirfd(listing), name.c_str(), 0);
+    }
+    ::closedir(listing);
+}
+
+}  // namespace
+
+std::string temporary_path(const std::filesystem::path& target) {
+    const std::filesystem::path directory = target.parent_path().empty() ? "." : target.parent_path();
+    return (directory / temporary_name(target, ::getpid())).string();
 }
 
 void move_into_place(const std::string& temporary, const std::filesystem::path& target) {
+    remove_abandoned_temporaries(target);
     // An existing file is swapped out atomically (RENAME_EXCHANGE) and then deleted under the
     // temporary name: a rename over it made ext4 start writing the new file to disk before
     // returning (its "auto_da_alloc" for replace-by-rename), 10 ms for a 1280x960 float EXR
@@ -177,6 +208,7 @@ void write_files_atomically(const std::vector<std::pair<std::filesystem::path, s
                 throw std::runtime_error("cannot write '" + file.target.string() + "': it is a directory");
             }
         }
+        for (const Pending& file : pending) remove_abandoned_temporaries(file.target);
         std::vector<Moved> moved;
         {
             std::vector<std::filesystem::path> directories;

@@ -21,7 +21,9 @@ namespace whitted {
 /// non-file replaced by a rename cannot be). The renames hold an flock on the directory, so two
 /// processes writing the same set of files at once leave one's whole set, never a mix.
 /// `.NAME.whitted-PID.tmp.EXT` beside `target`: where a file is finished before it is moved to
-/// `target` (hidden, and marked as ours, by process).
+/// `target` (hidden, and marked as ours, by process). A process killed with SIGKILL in the
+/// instant between naming and moving can leave one; the next move_into_place or
+/// write_files_atomically to the same target removes those whose process no longer exists.
 std::string temporary_path(const std::filesystem::path& target);
 
 /// Moves a finished file to `target` in one step: an existing regular file is swapped out
