@@ -52,6 +52,7 @@ struct QueryContext {
 struct AnalyticGeometry {
     ShapeKind kind;
     const Scene* scene;
+    Vec3 offset;  ///< Embree's coordinates are world minus this (Impl::choose_frame)
 };
 
 bool intersect_analytic(const AnalyticGeometry& geometry, unsigned prim, const Ray& ray, double t_max, ShapeHit& hit) {
@@ -67,6 +68,8 @@ void analytic_bounds(const RTCBoundsFunctionArguments* args) {
         world_bounds(geometry->scene->spheres[args->primID], lo, hi);
     else
         world_bounds(geometry->scene->boxes[args->primID], lo, hi);
+    lo -= geometry->offset;
+    hi -= geometry->offset;
     // Widen by a relative margin so that float rounding of the bounds never clips a hit.
     const Vec3 pad = (hi - lo) * 1e-6 + Vec3(1e-6);
     lo -= pad;
@@ -120,6 +123,35 @@ void analytic_occluded(const RTCOccludedFunctionNArguments* args) {
     }
 }
 
+Vec3 vertex(const TriangleMesh& mesh, uint32_t index) {
+    const float* p = &mesh.positions[4 * size_t(index)];
+    return {p[0], p[1], p[2]};
+}
+
+/// Embree's float test found `prim` of this mesh on some rays; each is kept only if its double
+/// ray meets the triangle's plane within (t_min, t_max). Where Embree's coordinates are large
+/// its float distances are off by more than the minimum distances (ulp(1e4) ≈ 1e-3, the shadow
+/// window), so a surface could find itself again or a blocker at the end of the range be kept
+/// or missed; the range is decided in double, as POV-Ray does, and Embree is handed a wider one
+/// (EmbreeFrame::exact_range). Only the range: whether the ray passes inside the triangle's
+/// edges stays Embree's decision, so a ray through an edge two triangles share is decided as
+/// before.
+void triangle_filter(const RTCFilterFunctionNArguments* args) {
+    const auto* mesh = static_cast<const TriangleMesh*>(args->geometryUserPtr);
+    const auto* context = reinterpret_cast<const QueryContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) continue;
+        const unsigned id = RTCRayN_id(args->ray, args->N, i);
+        if (!context->is_query(id)) continue;
+        const Ray& ray = context->rays[id];
+        const uint32_t* index = &mesh->indices[3 * size_t(RTCHitN_primID(args->hit, args->N, i))];
+        ShapeHit hit;
+        if (!hit_triangle_plane(vertex(*mesh, index[0]), vertex(*mesh, index[1]), vertex(*mesh, index[2]), ray, hit) ||
+            !(hit.t > ray.t_min && hit.t < ray.t_max))
+            args->valid[i] = 0;
+    }
+}
+
 /// The first error Embree reported. Embree calls record_embree_error from C code, where an
 /// exception must not pass, and from any render thread: it keeps the message, and the caller
 /// throws it once the Embree call has returned (throw_if_failed).
@@ -145,16 +177,32 @@ void record_embree_error(void* user, RTCError code, const char* message) {
     error->failed.store(true);
 }
 
-RTCRay make_embree_ray(const Ray& ray, unsigned id) {
+/// How Embree's float coordinates relate to the world (Impl::choose_frame).
+struct EmbreeFrame {
+    Vec3 offset;  ///< Embree's coordinates are world minus this
+    /// Triangle candidates are re-tested in double (triangle_filter), and Embree is handed a
+    /// wider range than the ray's, from 0 to a little past t_max, so that a hit whose float
+    /// distance falls just outside the range while its double one is inside still reaches
+    /// triangle_filter and the analytic callbacks, which decide the exact range in double.
+    bool exact_range = false;
+
+    float t_min(const Ray& ray) const { return exact_range ? 0.0f : float(ray.t_min); }
+    float t_max(const Ray& ray) const {
+        return exact_range ? std::nextafter(float(ray.t_max * (1 + 1e-6)), INFINITY) : float(ray.t_max);
+    }
+};
+
+RTCRay make_embree_ray(const Ray& ray, unsigned id, const EmbreeFrame& frame) {
+    const Vec3 origin = ray.origin - frame.offset;
     RTCRay r;
-    r.org_x = float(ray.origin.x);
-    r.org_y = float(ray.origin.y);
-    r.org_z = float(ray.origin.z);
+    r.org_x = float(origin.x);
+    r.org_y = float(origin.y);
+    r.org_z = float(origin.z);
     r.dir_x = float(ray.direction.x);
     r.dir_y = float(ray.direction.y);
     r.dir_z = float(ray.direction.z);
-    r.tnear = float(ray.t_min);
-    r.tfar = float(ray.t_max);
+    r.tnear = frame.t_min(ray);
+    r.tfar = frame.t_max(ray);
     r.time = 0;
     r.mask = 0xFFFFFFFFu;
     r.id = id;
@@ -165,15 +213,16 @@ RTCRay make_embree_ray(const Ray& ray, unsigned id) {
 /// Lane i of an Embree packet (RTCRay4/8/16) holds `ray`; `id` is the ray's index in the
 /// query, so callbacks find the double ray again.
 template <class RayPacket>
-void set_lane(RayPacket& packet, int i, const Ray& ray, unsigned id) {
-    packet.org_x[i] = float(ray.origin.x);
-    packet.org_y[i] = float(ray.origin.y);
-    packet.org_z[i] = float(ray.origin.z);
+void set_lane(RayPacket& packet, int i, const Ray& ray, unsigned id, const EmbreeFrame& frame) {
+    const Vec3 origin = ray.origin - frame.offset;
+    packet.org_x[i] = float(origin.x);
+    packet.org_y[i] = float(origin.y);
+    packet.org_z[i] = float(origin.z);
     packet.dir_x[i] = float(ray.direction.x);
     packet.dir_y[i] = float(ray.direction.y);
     packet.dir_z[i] = float(ray.direction.z);
-    packet.tnear[i] = float(ray.t_min);
-    packet.tfar[i] = float(ray.t_max);
+    packet.tnear[i] = frame.t_min(ray);
+    packet.tfar[i] = frame.t_max(ray);
     packet.time[i] = 0;
     packet.mask[i] = 0xFFFFFFFFu;
     packet.id[i] = id;
@@ -252,11 +301,6 @@ RTCDevice make_device(const std::string& config_start, const std::string& isa) {
         throw std::invalid_argument("WHITTED_EMBREE_ISA=" + isa + ": this CPU cannot run Embree's " + isa +
                                     " code (unset it to let Embree choose)");
     throw std::runtime_error("cannot create the Embree device (Embree error " + std::to_string(int(code)) + ")");
-}
-
-Vec3 vertex(const TriangleMesh& mesh, uint32_t index) {
-    const float* p = &mesh.positions[4 * size_t(index)];
-    return {p[0], p[1], p[2]};
 }
 
 Vec3 vertex_normal(const TriangleMesh& mesh, uint32_t index) {
@@ -346,10 +390,15 @@ struct Accelerator::Impl {
     // geomID → what it is: a mesh index, or the sphere/box user geometry.
     std::vector<ShapeKind> kinds;
     std::vector<uint32_t> mesh_of_geometry;
-    AnalyticGeometry spheres{ShapeKind::spheres, nullptr};
-    AnalyticGeometry boxes{ShapeKind::boxes, nullptr};
+    AnalyticGeometry spheres{ShapeKind::spheres, nullptr, {}};
+    AnalyticGeometry boxes{ShapeKind::boxes, nullptr, {}};
     RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;  ///< of the scene and its meshes (build_quality)
     int lane_width = 1;                                  ///< rays per Embree packet call (native_lane_width)
+    /// Embree works in float in a frame of its own (choose_frame). Rays, vertices and bounds
+    /// are shifted in double before they are rounded, so a scene far from the origin keeps
+    /// float's precision relative to its own size; every answer is still recomputed in world
+    /// double from the scene's own data.
+    EmbreeFrame frame;
 
     Impl(const Scene& s, int threads, const std::string& instruction_set) : scene(s), isa(instruction_set) {
         spheres.scene = boxes.scene = &scene;
@@ -363,6 +412,8 @@ struct Accelerator::Impl {
         rtc_scene = rtcNewScene(device);
         quality = build_quality();
         rtcSetSceneBuildQuality(rtc_scene, quality);
+        frame = choose_frame();
+        spheres.offset = boxes.offset = frame.offset;
         for (uint32_t m = 0; m < scene.meshes.size(); ++m) add_mesh(m);
         if (!scene.spheres.empty()) add_analytic(spheres, scene.spheres.size());
         if (!scene.boxes.empty()) add_analytic(boxes, scene.boxes.size());
@@ -391,6 +442,46 @@ struct Accelerator::Impl {
         return double(triangles) > camera_rays / 4 ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM;
     }
 
+    /// The frame: centred on the bounds of the scene's finite shapes when they lie further from
+    /// the origin than their half extent (the shifted coordinates then keep at least one more
+    /// bit), otherwise the world's, and Embree reads the meshes' own arrays. Where the shifted
+    /// coordinates still reach M, Embree's float distances may be off by some ulp(M), 2^-23 M
+    /// each: once 16 of them exceed a quarter of the smallest minimum distance (surface_t_min,
+    /// 1e-4), that is from M ≈ 13 on, the range of each triangle candidate is decided in double
+    /// (EmbreeFrame::exact_range). Below that Embree's range decision stands: it cannot move a
+    /// hit across 1e-4 or the shadow window's 1e-3, and the filter's call per candidate cost the
+    /// 100k-triangle anchor 35 % (docs/validation.md, "Far from the origin").
+    EmbreeFrame choose_frame() const {
+        constexpr double inf = std::numeric_limits<double>::infinity();
+        Vec3 lo(inf), hi(-inf);
+        for (const TriangleMesh& mesh : scene.meshes)
+            for (uint32_t i = 0; i < mesh.vertex_count(); ++i) {
+                lo = min(lo, vertex(mesh, i));
+                hi = max(hi, vertex(mesh, i));
+            }
+        for (const Sphere& sphere : scene.spheres) {
+            Vec3 a, b;
+            world_bounds(sphere, a, b);
+            lo = min(lo, a), hi = max(hi, b);
+        }
+        for (const Box& box : scene.boxes) {
+            Vec3 a, b;
+            world_bounds(box, a, b);
+            lo = min(lo, a), hi = max(hi, b);
+        }
+        EmbreeFrame chosen;
+        if (!(lo.x <= hi.x)) return chosen;  // no finite shape: Embree has nothing to find
+        const Vec3 centre = (lo + hi) * 0.5, half = (hi - lo) * 0.5;
+        const double far = std::max({std::fabs(centre.x), std::fabs(centre.y), std::fabs(centre.z)});
+        const double size = std::max({half.x, half.y, half.z});
+        if (std::isfinite(far) && far > size) chosen.offset = centre;
+        const Vec3 a = lo - chosen.offset, b = hi - chosen.offset;
+        const double reach =
+            std::max({std::fabs(a.x), std::fabs(a.y), std::fabs(a.z), std::fabs(b.x), std::fabs(b.y), std::fabs(b.z)});
+        chosen.exact_range = !(16 * std::ldexp(reach, -23) < ray_limits::surface_t_min / 4);
+        return chosen;
+    }
+
     void release() {
         if (rtc_scene) rtcReleaseScene(rtc_scene);
         if (device) rtcReleaseDevice(device);
@@ -401,12 +492,29 @@ struct Accelerator::Impl {
     void add_mesh(uint32_t m) {
         const TriangleMesh& mesh = scene.meshes[m];
         RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        // Shared buffers: Embree reads the scene's own arrays, no copy (positions are padded to 16 bytes).
-        rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.positions.data(), 0,
-                                   4 * sizeof(float), mesh.vertex_count());
+        if (frame.offset == Vec3(0.0)) {
+            // Shared buffers: Embree reads the scene's own arrays, no copy (positions are padded to 16 bytes).
+            rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.positions.data(), 0,
+                                       4 * sizeof(float), mesh.vertex_count());
+        } else {
+            auto* local = static_cast<float*>(rtcSetNewGeometryBuffer(
+                geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 4 * sizeof(float), mesh.vertex_count()));
+            for (uint32_t i = 0; i < mesh.vertex_count(); ++i) {
+                const Vec3 p = vertex(mesh, i) - frame.offset;
+                local[4 * size_t(i)] = float(p.x);
+                local[4 * size_t(i) + 1] = float(p.y);
+                local[4 * size_t(i) + 2] = float(p.z);
+                local[4 * size_t(i) + 3] = 0.0f;
+            }
+        }
         rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.indices.data(), 0,
                                    3 * sizeof(uint32_t), mesh.triangle_count());
         rtcSetGeometryBuildQuality(geometry, quality);  // Embree builds LOW only if both say so
+        if (frame.exact_range) {
+            rtcSetGeometryUserData(geometry, const_cast<TriangleMesh*>(&mesh));
+            rtcSetGeometryIntersectFilterFunction(geometry, triangle_filter);
+            rtcSetGeometryOccludedFilterFunction(geometry, triangle_filter);
+        }
         rtcCommitGeometry(geometry);
         const unsigned id = rtcAttachGeometry(rtc_scene, geometry);
         rtcReleaseGeometry(geometry);
@@ -500,7 +608,7 @@ struct Accelerator::Impl {
         QueryContext context(&ray, nullptr, 1, false);
         context.best_t[0] = ray.t_max;
         RTCRayHit rayhit;
-        rayhit.ray = make_embree_ray(ray, 0);
+        rayhit.ray = make_embree_ray(ray, 0, frame);
         rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(rtc_scene, &context.embree, &rayhit);
@@ -524,7 +632,7 @@ struct Accelerator::Impl {
             any |= is_query;
             if (is_query) {
                 context.best_t[i] = rays[i].t_max;
-                set_lane(packet.ray, lane, rays[i], unsigned(i));
+                set_lane(packet.ray, lane, rays[i], unsigned(i), frame);
             } else {
                 set_empty_lane(packet.ray, lane, unsigned(i));
             }
@@ -575,7 +683,7 @@ struct Accelerator::Impl {
     bool occluded(const Ray& ray) const {
         if (occluded_by_plane(ray)) return true;
         QueryContext context(&ray, nullptr, 1, false);
-        RTCRay r = make_embree_ray(ray, 0);
+        RTCRay r = make_embree_ray(ray, 0, frame);
         rtcOccluded1(rtc_scene, &context.embree, &r);
         return r.tfar < 0;
     }
@@ -593,7 +701,7 @@ struct Accelerator::Impl {
             valid[lane] = is_query ? -1 : 0;
             any |= is_query;
             if (is_query)
-                set_lane(packet, lane, rays[i], unsigned(i));
+                set_lane(packet, lane, rays[i], unsigned(i), frame);
             else
                 set_empty_lane(packet, lane, unsigned(i));
         }
