@@ -214,5 +214,25 @@ TEST(Triangle, PlaneHitClampsBarycentricsOntoTheTriangle) {
     EXPECT_FALSE(hit_triangle_plane(v0, v1, v2, ray_from({0.2, 0.2, 1}, {1, 0, 0}), hit));
 }
 
+// A small sphere far away: |oc|² and along² agree in nearly every digit, so a test that
+// subtracts them loses r² entirely (radius 1e-3 at 1e5: relative error in the half chord of
+// order 1). The distances here are closed-form: t = D − sqrt(r² − p²) at perpendicular offset p.
+TEST(Sphere, SmallAndFarStaysAccurate) {
+    for (const double distance : {1e3, 1e5, 1e6}) {
+        const double r = 1e-3;
+        const Sphere sphere{Transform(), {0.3, -0.2, distance}, r, 0};
+        for (const double offset : {0.0, 0.5 * r, 0.9 * r}) {
+            ShapeHit hit;
+            const Ray ray{{0.3 + offset, -0.2, 0}, {0, 0, 1}, t_min, 1e9};
+            ASSERT_TRUE(intersect_sphere(sphere, ray, t_min, 1e9, hit)) << distance << " " << offset;
+            const double expected = distance - std::sqrt(r * r - offset * offset);
+            // A few ulps of the distance itself: the best a double t can do.
+            EXPECT_NEAR(hit.t, expected, 8 * distance * 1.1e-16 + 1e-12) << distance << " " << offset;
+        }
+        ShapeHit miss;
+        EXPECT_FALSE(intersect_sphere(sphere, {{0.3 + 1.01 * r, -0.2, 0}, {0, 0, 1}, t_min, 1e9}, t_min, 1e9, miss));
+    }
+}
+
 }  // namespace
 }  // namespace whitted
