@@ -356,6 +356,7 @@ std::string embree_isa_from_environment() {
 }
 
 void require_embree_isa(const std::string& isa) {
+    if (isa.empty()) return;  // Embree's own choice: every CPU it starts on can run it
     rtcReleaseDevice(make_device("verbose=0", isa));
 }
 
