@@ -618,6 +618,29 @@ struct Accelerator::Impl {
                           context.best_normal[0], out);
     }
 
+    /// Calls `lanes.operator()<W>(first)` for first = 0, W, 2W, ... < count, with W the native
+    /// lane_width, so that each packet query is written once for every width. False when
+    /// Embree has no packets (lane_width 1): the caller then traces the rays one by one.
+    template <class Lanes>
+    bool in_native_groups(int count, Lanes&& lanes) const {
+        const auto groups = [&]<int W>() {
+            for (int first = 0; first < count; first += W) lanes.template operator()<W>(first);
+        };
+        switch (lane_width) {
+            case 16:
+                groups.template operator()<16>();
+                return true;
+            case 8:
+                groups.template operator()<8>();
+                return true;
+            case 4:
+                groups.template operator()<4>();
+                return true;
+            default:
+                return false;
+        }
+    }
+
     /// Rays [first, first + W) of a packet through Embree's W-wide call. Every lane is written:
     /// a query, or an empty lane (set_empty_lane).
     template <int W>
@@ -654,22 +677,11 @@ struct Accelerator::Impl {
 
     void intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found) const {
         QueryContext context(rays, active, count, true);
-        switch (lane_width) {
-            case 16:
-                intersect_lanes<16>(context, rays, active, 0, count, hits, found);
-                break;
-            case 8:
-                for (int first = 0; first < count; first += 8)
-                    intersect_lanes<8>(context, rays, active, first, count, hits, found);
-                break;
-            case 4:
-                for (int first = 0; first < count; first += 4)
-                    intersect_lanes<4>(context, rays, active, first, count, hits, found);
-                break;
-            default:
-                for (int i = 0; i < count; ++i)
-                    if (active[i]) found[i] = intersect(rays[i], hits[i]);
-        }
+        const bool traced = in_native_groups(
+            count, [&]<int W>(int first) { intersect_lanes<W>(context, rays, active, first, count, hits, found); });
+        if (!traced)
+            for (int i = 0; i < count; ++i)
+                if (active[i]) found[i] = intersect(rays[i], hits[i]);
         embree_error.throw_if_failed("while tracing rays");
     }
 
@@ -717,22 +729,11 @@ struct Accelerator::Impl {
         bool query[packet_size];
         for (int i = 0; i < count; ++i) query[i] = active[i] && !(blocked[i] = occluded_by_plane(rays[i]));
         QueryContext context(rays, query, count, true);
-        switch (lane_width) {
-            case 16:
-                occluded_lanes<16>(context, rays, query, 0, count, blocked);
-                break;
-            case 8:
-                for (int first = 0; first < count; first += 8)
-                    occluded_lanes<8>(context, rays, query, first, count, blocked);
-                break;
-            case 4:
-                for (int first = 0; first < count; first += 4)
-                    occluded_lanes<4>(context, rays, query, first, count, blocked);
-                break;
-            default:
-                for (int i = 0; i < count; ++i)
-                    if (query[i]) blocked[i] = occluded(rays[i]);
-        }
+        const bool traced = in_native_groups(
+            count, [&]<int W>(int first) { occluded_lanes<W>(context, rays, query, first, count, blocked); });
+        if (!traced)
+            for (int i = 0; i < count; ++i)
+                if (query[i]) blocked[i] = occluded(rays[i]);
         embree_error.throw_if_failed("while tracing shadow rays");
     }
 };
