@@ -14,7 +14,6 @@ Usage: check_faults.py WHITTED symlinks SCENE [--povray POVRAY] | signals | povr
 
 import argparse
 import os
-import shlex
 import signal
 import subprocess
 import sys
@@ -22,6 +21,8 @@ import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import fake_povray  # noqa: E402
 REPORT_FILES = ["povray.log", "povray-16bit.png", "scene.pov", "scene.ini", "ours.exr", "povray.exr", "diff.exr",
                 "ours.png", "povray.png", "diff.png", "metrics.json", "report.html"]
 SCENE = ("version: 1\ncamera: { eye: [0, 0, 5], look_at: [0, 0, 0] }\n"
@@ -57,15 +58,6 @@ def symlinks(whitted, scene, povray):
     return problems
 
 
-def fake_povray(directory):
-    wrapper = os.path.join(directory, "povray")
-    with open(wrapper, "w") as f:
-        f.write(f"#!/bin/sh\nexec {shlex.quote(sys.executable)} {shlex.quote(os.path.join(HERE, 'fake_povray.py'))}"
-                ' "$@"\n')
-    os.chmod(wrapper, 0o755)
-    return wrapper
-
-
 def running(pid):
     try:
         os.kill(pid, 0)
@@ -84,7 +76,7 @@ def interrupt(whitted, d, mode, sig, to_group):
     os.mkdir(tmp)
     pidfile = os.path.join(d, f"pid-{mode}-{sig.name}")
     scene = os.path.join(d, "background.yaml")
-    environment = dict(os.environ, TMPDIR=tmp, WHITTED_POVRAY=fake_povray(d), FAKE_POVRAY_MODE=mode,
+    environment = dict(os.environ, TMPDIR=tmp, WHITTED_POVRAY=fake_povray.install(d), FAKE_POVRAY_MODE=mode,
                        FAKE_POVRAY_PIDFILE=pidfile)
     process = subprocess.Popen([whitted, "check", scene, "-q"], env=environment, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True, start_new_session=True)

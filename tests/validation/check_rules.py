@@ -9,26 +9,18 @@ Usage: check_rules.py WHITTED VALIDATE_SCRIPT"""
 
 import json
 import os
-import shlex
 import subprocess
 import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import fake_povray  # noqa: E402
 SCENE = ("version: 1\ncamera: { eye: [0, 0, 5], look_at: [0, 0, 0] }\n"
          "image: { width: 96, height: 72, background: [0.5, 0.25, 0.125] }\n"
          "lights: []\nmaterials: {}\nobjects: []\n")
 CODES = "32768,16384,8192"  # the background, rounded as a 16-bit PNG holds it
 SIX_FAR = ";".join(f"{10 + 7 * i},{20 + i},1,{16384 + 1000}" for i in range(6))  # 6 of 6912: under 0.1 %
-
-
-def fake_povray(directory):
-    wrapper = os.path.join(directory, "povray")
-    with open(wrapper, "w") as f:
-        f.write(f"#!/bin/sh\nexec {shlex.quote(sys.executable)} {shlex.quote(os.path.join(HERE, 'fake_povray.py'))}"
-                ' "$@"\n')
-    os.chmod(wrapper, 0o755)
-    return wrapper
 
 
 def check(whitted, scene, environment, *options):
@@ -45,7 +37,7 @@ def main():
         scene = os.path.join(directory, "background.yaml")
         with open(scene, "w") as f:
             f.write(SCENE)
-        base = dict(os.environ, WHITTED_POVRAY=fake_povray(directory), FAKE_POVRAY_CODES=CODES)
+        base = dict(os.environ, WHITTED_POVRAY=fake_povray.install(directory), FAKE_POVRAY_CODES=CODES)
 
         def case(name, expect_code, expect_in, expect_not_in=(), options=(), **fake):
             code, verdict, stderr = check(whitted, scene, dict(base, **fake), *options)

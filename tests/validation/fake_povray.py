@@ -11,12 +11,23 @@ Reads Output_File_Name and +W/+H from the .ini it is given. The environment says
 
 import os
 import re
+import shlex
 import signal
 import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import images  # noqa: E402
+
+
+def install(directory):
+    """Writes `directory`/povray, which runs this stand-in with the same Python; returns its
+    path, for WHITTED_POVRAY."""
+    wrapper = os.path.join(directory, "povray")
+    with open(wrapper, "w") as f:
+        f.write(f"#!/bin/sh\nexec {shlex.quote(sys.executable)} {shlex.quote(os.path.abspath(__file__))} \"$@\"\n")
+    os.chmod(wrapper, 0o755)
+    return wrapper
 
 
 def main():
