@@ -71,6 +71,36 @@ def running(pid):
         return False
 
 
+def stop_and_inspect(process, name, sig, to_group, povray, tmp):
+    """Sends `sig` to a running `whitted check` (or its process group) and checks what must hold
+    afterwards: it ended within 5 s with 128 + sig, POV-Ray (pid `povray`) ended with it, and
+    nothing is left in `tmp` ($TMPDIR). Returns (problems, stderr, seconds taken, leftovers)."""
+    sent = time.monotonic()
+    if to_group:
+        os.killpg(process.pid, sig)
+    else:
+        process.send_signal(sig)
+    problems = []
+    try:
+        _, err = process.communicate(timeout=10)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        _, err = process.communicate()
+        problems.append(f"{name}: whitted still running 10 s after the signal")
+    took = time.monotonic() - sent
+    if process.returncode != 128 + sig.value:
+        problems.append(f"{name}: exit {process.returncode}, expected {128 + sig.value} ({err.strip()!r})")
+    if took > 5:
+        problems.append(f"{name}: took {took:.1f} s to stop (limit 5 s)")
+    if running(povray):
+        os.kill(povray, signal.SIGKILL)
+        problems.append(f"{name}: POV-Ray (pid {povray}) still running after whitted ended")
+    leftovers = sorted(os.listdir(tmp))
+    if leftovers:
+        problems.append(f"{name}: temporary directories left in $TMPDIR: {leftovers}")
+    return problems, err, took, leftovers
+
+
 def interrupt(whitted, d, mode, sig, to_group):
     tmp = os.path.join(d, f"tmp-{mode}-{sig.name}")
     os.mkdir(tmp)
@@ -91,29 +121,7 @@ def interrupt(whitted, d, mode, sig, to_group):
     with open(pidfile) as f:
         povray = int(f.read())
     leftovers_before = sorted(os.listdir(tmp))
-    sent = time.monotonic()
-    if to_group:
-        os.killpg(process.pid, sig)
-    else:
-        process.send_signal(sig)
-    problems = []
-    try:
-        out, err = process.communicate(timeout=10)
-    except subprocess.TimeoutExpired:
-        process.kill()
-        out, err = process.communicate()
-        problems.append(f"{name}: whitted still running 10 s after the signal")
-    took = time.monotonic() - sent
-    if process.returncode != 128 + sig.value:
-        problems.append(f"{name}: exit {process.returncode}, expected {128 + sig.value} ({err.strip()!r})")
-    if took > 5:
-        problems.append(f"{name}: took {took:.1f} s to stop (limit 5 s)")
-    if running(povray):
-        os.kill(povray, signal.SIGKILL)
-        problems.append(f"{name}: POV-Ray (pid {povray}) still running after whitted ended")
-    leftovers = sorted(os.listdir(tmp))
-    if leftovers:
-        problems.append(f"{name}: temporary directories left in $TMPDIR: {leftovers}")
+    problems, err, took, leftovers = stop_and_inspect(process, name, sig, to_group, povray, tmp)
     if "interrupted" not in err:
         problems.append(f"{name}: no 'interrupted' message: {err!r}")
     print(f"{name}: exit {process.returncode} in {took:.2f} s; $TMPDIR held {leftovers_before} while POV-Ray ran, "
@@ -170,29 +178,7 @@ def povray_interrupt(whitted, d, sig, to_group):
     time.sleep(1.0)  # well into POV-Ray's render
     if process.poll() is not None:
         return [f"{name}: the check ended before the signal (exit {process.returncode}): scene too small"]
-    sent = time.monotonic()
-    if to_group:
-        os.killpg(process.pid, sig)
-    else:
-        process.send_signal(sig)
-    problems = []
-    try:
-        _, err = process.communicate(timeout=10)
-    except subprocess.TimeoutExpired:
-        process.kill()
-        _, err = process.communicate()
-        problems.append(f"{name}: whitted still running 10 s after the signal")
-    took = time.monotonic() - sent
-    if process.returncode != 128 + sig.value:
-        problems.append(f"{name}: exit {process.returncode}, expected {128 + sig.value} ({err.strip()!r})")
-    if took > 5:
-        problems.append(f"{name}: took {took:.1f} s to stop (limit 5 s)")
-    if running(povray):
-        os.kill(povray, signal.SIGKILL)
-        problems.append(f"{name}: POV-Ray (pid {povray}) still running after whitted ended")
-    leftovers = sorted(os.listdir(tmp))
-    if leftovers:
-        problems.append(f"{name}: temporary directories left in $TMPDIR: {leftovers}")
+    problems, err, took, leftovers = stop_and_inspect(process, name, sig, to_group, povray, tmp)
     print(f"{name}: exit {process.returncode} in {took:.2f} s, {leftovers} left" + ("" if problems else ", ok"))
     return problems
 
