@@ -293,6 +293,13 @@ static std::string write_sdl(const SceneDescription& d, const ConvertOptions& op
              "\n  look_at " + vec(c.look_at.value) + "\n}\n";
     }
 
+    // Lights and objects go inside one light_group, whose lights light only its objects (here:
+    // all of them), because POV-Ray keeps no shadow cache for a light-group light. Outside a
+    // light_group POV-Ray first re-tests the object that last blocked the same light, accepting
+    // it from t = 1e-4 instead of the 1e-3 its full shadow test (and Whitted) uses, so a pixel's
+    // shadow would depend on which pixel POV-Ray shaded before it (docs/pov-model.md §3).
+    const bool light_group = !d.lights.empty() && !d.objects.empty();
+    if (light_group) o += "light_group {\n";
     for (const auto& light : d.lights) {
         const Color intensity = light.intensity.value * exposure;
         if (light.type == LightType::point) {
@@ -307,6 +314,7 @@ static std::string write_sdl(const SceneDescription& d, const ConvertOptions& op
     }
     SdlWriter writer(d, o);
     writer.objects(d.objects, Transform());
+    if (light_group) o += "  global_lights off\n}\n";
     return o;
 }
 
