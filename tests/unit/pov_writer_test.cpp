@@ -57,6 +57,30 @@ std::string sdl_for(const std::string& objects_and_materials, const std::string&
     return pov::scene_to_sdl(d);
 }
 
+// Lights and objects sit in one light_group, after the camera: POV-Ray keeps no shadow cache
+// for a light-group light (docs/pov-model.md §3). The group lights only what it holds, so every
+// object must be inside it, and `global_lights off` keeps nothing outside it lit twice.
+TEST(PovWriter, LightsAndObjectsShareOneLightGroup) {
+    const std::string sdl = sdl_for(
+        "lights: [{type: point, position: [1, 2, 3]}, {type: directional, direction: [0, -1, 0]}]\n"
+        "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, material: {kd: 0.5}}\n"
+        "  - {type: plane, point: [0, -1, 0], normal: [0, 1, 0], material: {kd: 0.5}}\n");
+    ASSERT_EQ(count_of(sdl, "light_group {"), 1u);
+    const size_t group = sdl.find("light_group {");
+    EXPECT_LT(sdl.find("camera {"), group);
+    const size_t end = sdl.rfind("global_lights off");
+    ASSERT_NE(end, std::string::npos);
+    for (const char* word : {"light_source {", "sphere {", "plane {"}) {
+        for (size_t at = sdl.find(word); at != std::string::npos; at = sdl.find(word, at + 1)) {
+            EXPECT_GT(at, group) << word;
+            EXPECT_LT(at, end) << word;
+        }
+    }
+    EXPECT_EQ(sdl.substr(end), "global_lights off\n}\n");  // the group closes the file
+    // Without objects there is nothing to light: no group (POV-Ray refuses an empty one).
+    EXPECT_EQ(count_of(sdl_for("lights: [{type: point, position: [1, 2, 3]}]\n"), "light_group"), 0u);
+}
+
 // Awkward doubles (0.1 + 0.2, tiny, huge, many digits) come back bit for bit.
 TEST(PovWriter, NumbersRoundTripExactly) {
     const std::string text =
