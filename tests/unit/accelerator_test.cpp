@@ -255,5 +255,40 @@ INSTANTIATE_TEST_SUITE_P(EveryIsa, PacketsPerIsa, testing::ValuesIn(embree_isa_n
                              return name;
                          });
 
+// The geometric normal is the face's, whatever the vertex normals say; the shading normal is
+// their blend. On a smooth triangle in z = 0 whose vertex normals lean far over (+x, and one
+// even below the face), a ray from +z hits the face's front (Ng = +z) while the blended normal
+// leans toward +x. Closed form: at barycentric (u, v) = (1/3, 1/3) the blend is the plain mean
+// of the three unit normals, renormalised. Spheres, boxes and planes have one normal for both.
+TEST(Accelerator, GeometricNormalBesideTheShadingNormal) {
+    const Scene scene = test::scene_from(test::join_lines({
+        "camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}",
+        "image: {width: 8, height: 8}",
+        "objects:",
+        "  - {type: mesh, material: {kd: 0.5}, vertices: [[0, 0, 0], [3, 0, 0], [0, 3, 0]],",
+        "     normals: [[1, 0, 0.2], [0.6, 0, 0.8], [1, 0, -0.3]], triangles: [[0, 1, 2]]}",
+        "  - {type: sphere, center: [10, 0, 0], radius: 1, material: {kd: 0.5}}",
+    }));
+    const Accelerator accelerator(scene, 1);
+    SurfaceHit hit;
+    ASSERT_TRUE(accelerator.intersect({{1, 1, 5}, {0, 0, -1}, 1e-4, 1e7}, hit));
+    EXPECT_DOUBLE_EQ(hit.t, 5.0);
+    EXPECT_DOUBLE_EQ(hit.geometric_normal.x, 0.0);
+    EXPECT_DOUBLE_EQ(hit.geometric_normal.y, 0.0);
+    EXPECT_DOUBLE_EQ(hit.geometric_normal.z, 1.0);
+    const Vec3 mean = (normalize(Vec3{1, 0, 0.2}) + normalize(Vec3{0.6, 0, 0.8}) + normalize(Vec3{1, 0, -0.3})) / 3.0;
+    const Vec3 expected = normalize(mean);
+    EXPECT_NEAR(hit.normal.x, expected.x, 1e-6);  // vertex normals are stored as floats
+    EXPECT_NEAR(hit.normal.y, expected.y, 1e-6);
+    EXPECT_NEAR(hit.normal.z, expected.z, 1e-6);
+    EXPECT_GT(hit.normal.x, 0.9);  // the two normals are far apart: about 74 degrees
+
+    ASSERT_TRUE(accelerator.intersect({{10, 0, 5}, {0, 0, -1}, 1e-4, 1e7}, hit));
+    EXPECT_EQ(hit.geometric_normal.x, hit.normal.x);
+    EXPECT_EQ(hit.geometric_normal.y, hit.normal.y);
+    EXPECT_EQ(hit.geometric_normal.z, hit.normal.z);
+    EXPECT_DOUBLE_EQ(hit.normal.z, 1.0);
+}
+
 }  // namespace
 }  // namespace whitted

@@ -579,11 +579,13 @@ struct Accelerator::Impl {
                     hit.normal = embree_normal;
                 }
                 out.normal = triangle_normal(mesh, prim, hit);
+                out.geometric_normal = normalize(hit.normal);
                 out.material = mesh.triangle_materials.empty() ? mesh.material : mesh.triangle_materials[prim];
             } else {
                 // The callback computed this hit in double and kept it.
                 hit.t = best_t;
                 out.normal = normalize(best_normal);
+                out.geometric_normal = out.normal;
                 out.material =
                     kinds[geom] == ShapeKind::spheres ? scene.spheres[prim].material : scene.boxes[prim].material;
             }
@@ -597,6 +599,7 @@ struct Accelerator::Impl {
                 t_max = plane_hit.t;
                 out.t = plane_hit.t;
                 out.normal = plane.normal;
+                out.geometric_normal = plane.normal;
                 out.material = plane.material;
                 found = true;
             }

@@ -37,6 +37,11 @@ struct SurfaceHit {
     Vec3 point;
     Vec3 normal;  ///< unit shading normal (interpolated for smooth meshes), not yet turned to the ray
     uint32_t material = 0;
+    /// Unit geometric normal: the triangle's face normal ((v1 − v0) × (v2 − v0)), or the
+    /// analytic normal of a sphere, box or plane (the same as `normal` there); not turned.
+    /// Which side is lit is still decided with `normal`, as POV-Ray decides it (docs/validation.md,
+    /// "Which side is lit").
+    Vec3 geometric_normal;
 };
 
 /// Ray queries over a Scene. Embree's BVH finds the candidates (triangles natively, spheres and
