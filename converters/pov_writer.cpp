@@ -190,15 +190,26 @@ private:
 
     /// A mesh2 in world space: vertices and normals transformed in double exactly as Whitted
     /// does before both store them as float, so the two renderers see the same triangles.
+    /// A mesh far from the origin is written about a centre of its own and moved there with
+    /// `translate`: POV-Ray keeps each triangle's plane as a float normal and a float distance
+    /// from the origin, which far out is too coarse (spaced 1e-3 at 1e4) and gave POV-Ray
+    /// self-shadowing speckles; about the centre the distances are small, and the ray is moved
+    /// into the mesh's frame in double. The triangles are unchanged: each vertex minus the
+    /// centre is exact in float (checked, axis by axis), so centre + vertex is the same float
+    /// vertex Whitted uses.
     void mesh(const std::vector<Vec3>& vertices, const std::vector<Vec3>& normals,
               const std::vector<std::array<int64_t, 3>>& triangles, const Transform& to_world,
               const Material& material) {
         std::string& o = m_out;
-        o += "mesh2 {\n  vertex_vectors { " + std::to_string(vertices.size());
+        std::vector<Vec3> world;  // the float vertices, as doubles
+        world.reserve(vertices.size());
         for (const Vec3& v : vertices) {
             const Vec3 w = to_world.apply_point(v);
-            o += ",\n    " + vec({float(w.x), float(w.y), float(w.z)});
+            world.push_back({float(w.x), float(w.y), float(w.z)});
         }
+        const Vec3 centre = mesh_centre(world);
+        o += "mesh2 {\n  vertex_vectors { " + std::to_string(vertices.size());
+        for (const Vec3& w : world) o += ",\n    " + vec(w - centre);
         o += " }\n";
         if (!normals.empty()) {
             o += "  normal_vectors { " + std::to_string(normals.size());
@@ -213,7 +224,27 @@ private:
         o += "  face_indices { " + std::to_string(triangles.size());
         for (const auto& t : triangles)
             o += ",\n    <" + std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " + std::to_string(t[2]) + ">";
-        o += " }\n  " + texture(material) + "\n}\n";
+        o += " }\n  " + texture(material) + "\n";
+        if (!(centre == Vec3(0.0))) o += "  translate " + vec(centre) + "\n";
+        o += "}\n";
+    }
+
+    /// Per axis: a float near the vertices' middle, if the mesh is far out on that axis (beyond
+    /// far_mesh_coordinate) and every vertex minus it is exactly a float; else 0 (no move).
+    static Vec3 mesh_centre(const std::vector<Vec3>& world) {
+        constexpr double far_mesh_coordinate = 16;  // below it, float plane distances are within 1e-6
+        double centre[3] = {0, 0, 0};
+        if (world.empty()) return Vec3(0.0);
+        for (int axis = 0; axis < 3; ++axis) {
+            double lo = INFINITY, hi = -INFINITY;
+            for (const Vec3& w : world) lo = std::min(lo, w[axis]), hi = std::max(hi, w[axis]);
+            if (std::max(std::fabs(lo), std::fabs(hi)) < far_mesh_coordinate) continue;
+            const double c = float(0.5 * (lo + hi));
+            bool exact = true;
+            for (const Vec3& w : world) exact = exact && double(float(w[axis] - c)) == w[axis] - c;
+            if (exact) centre[axis] = c;
+        }
+        return {centre[0], centre[1], centre[2]};
     }
 
     const SceneDescription& m_description;

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 
@@ -22,7 +23,7 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-/// The `count` numbers that follow `prefix` in `text` (separators: spaces, commas, '<', '>'),
+/// The `count` numbers that follow `prefix` in `text` (separators: spaces, newlines, commas, '<', '>'),
 /// read with strtod exactly as a C library reads a decimal.
 std::vector<double> numbers_after(const std::string& text, const std::string& prefix, size_t count, size_t from = 0) {
     const size_t at = text.find(prefix, from);
@@ -31,7 +32,7 @@ std::vector<double> numbers_after(const std::string& text, const std::string& pr
     const char* p = text.c_str() + at + prefix.size();
     std::vector<double> out;
     while (out.size() < count) {
-        while (*p == ' ' || *p == ',' || *p == '<' || *p == '>') ++p;
+        while (*p == ' ' || *p == ',' || *p == '<' || *p == '>' || *p == '\n') ++p;
         char* end = nullptr;
         const double value = std::strtod(p, &end);
         EXPECT_NE(end, p) << "no number at '" << std::string(p, std::min<size_t>(20, std::strlen(p))) << "'";
@@ -40,6 +41,13 @@ std::vector<double> numbers_after(const std::string& text, const std::string& pr
         p = end;
     }
     return out;
+}
+
+/// [x, y, z] in YAML, each number with enough digits to read back the same double.
+std::string fmt_vec(const Vec3& v) {
+    char buffer[96];
+    std::snprintf(buffer, sizeof buffer, "[%.17g, %.17g, %.17g]", v.x, v.y, v.z);
+    return buffer;
 }
 
 size_t count_of(const std::string& text, const std::string& word) {
@@ -79,6 +87,34 @@ TEST(PovWriter, LightsAndObjectsShareOneLightGroup) {
     EXPECT_EQ(sdl.substr(end), "global_lights off\n}\n");  // the group closes the file
     // Without objects there is nothing to light: no group (POV-Ray refuses an empty one).
     EXPECT_EQ(count_of(sdl_for("lights: [{type: point, position: [1, 2, 3]}]\n"), "light_group"), 0u);
+}
+
+// A mesh far from the origin is written about a centre of its own plus `translate`, so that
+// POV-Ray's float plane distances stay small; centre + written vertex must be exactly the float
+// world vertex Whitted renders. A mesh near the origin is written as it is, with no translate.
+TEST(PovWriter, FarMeshWrittenAboutItsOwnCentreWithTheSameFloatVertices) {
+    const std::vector<Vec3> far{{100000.3, 70000.7, -40000.1}, {100001.9, 70000.2, -39999.5}, {99999.1, 70002.6, -40000.9}};
+    std::string mesh = "objects:\n  - {type: mesh, material: {kd: 0.5}, triangles: [[0, 1, 2]], vertices: [";
+    for (const Vec3& v : far) mesh += fmt_vec(v) + (&v == &far.back() ? "" : ", ");
+    mesh += "]}\n";
+    const std::string sdl = sdl_for(mesh);
+    const auto centre = numbers_after(sdl, "translate", 3);
+    ASSERT_EQ(centre.size(), 3u);
+    for (double c : centre) EXPECT_EQ(double(float(c)), c);  // the centre itself is a float
+    const auto written = numbers_after(sdl, "vertex_vectors { 3,", 9);
+    for (size_t i = 0; i < 3; ++i) {
+        for (int axis = 0; axis < 3; ++axis) {
+            const double local = written[3 * i + axis];
+            EXPECT_EQ(double(float(local)), local);  // POV-Ray stores it as this float exactly
+            EXPECT_EQ(local + centre[axis], double(float(far[i][axis]))) << "vertex " << i << " axis " << axis;
+            EXPECT_LT(std::fabs(local), 4.0);
+        }
+    }
+    const std::string near = sdl_for(
+        "objects:\n  - {type: mesh, material: {kd: 0.5}, triangles: [[0, 1, 2]], "
+        "vertices: [[0.3, 0.7, -0.1], [1.9, 0.2, 0.5], [-0.9, 2.6, -0.9]]}\n");
+    EXPECT_THAT(near, Not(HasSubstr("translate")));
+    EXPECT_EQ(numbers_after(near, "vertex_vectors { 3,", 3), (std::vector<double>{float(0.3), float(0.7), float(-0.1)}));
 }
 
 // Awkward doubles (0.1 + 0.2, tiny, huge, many digits) come back bit for bit.
