@@ -79,11 +79,20 @@ objects:
 
 
 def main() -> None:
+    # generate.py [OUT_DIR [NAME ...]]: all three anchors, or only those named (the POV-Ray
+    # tier's pov.torus100k makes torus100k alone).
     out = Path(sys.argv[1] if len(sys.argv) > 1 else "build/bench")
+    names = set(sys.argv[2:]) or {"spheres", "torus100k", "torus1m"}
+    unknown = names - {"spheres", "torus100k", "torus1m"}
+    if unknown:
+        sys.exit(f"generate.py: unknown scene(s) {sorted(unknown)}; expected spheres, torus100k, torus1m")
     out.mkdir(parents=True, exist_ok=True)
-    spheres(out)
-    torus(out, "torus100k", 316, 158)
-    torus(out, "torus1m", 1000, 500)
+    if "spheres" in names:
+        spheres(out)
+    if "torus100k" in names:
+        torus(out, "torus100k", 316, 158)
+    if "torus1m" in names:
+        torus(out, "torus1m", 1000, 500)
     print(out)
 
 

@@ -557,8 +557,14 @@ struct Accelerator::Impl {
     }
 
     /// The exact hit for what Embree found on one ray (geom == invalid: nothing), then the planes.
+    /// `retry` is set, and nothing is found, when Embree's nearest candidate is a triangle that
+    /// the double ray meets outside its range: a ray leaving a surface at a grazing angle can
+    /// start on (or within rounding of) a neighbouring triangle's plane, which Embree's float
+    /// distance puts past t_min while in double it is 0, behind the ray or too near. Such a
+    /// candidate is no hit; the caller traces the ray again beyond it (intersect_beyond).
     bool finish_hit(const Ray& ray, unsigned geom, unsigned prim, float u, float v, float t, const Vec3& embree_normal,
-                    double best_t, const Vec3& best_normal, SurfaceHit& out) const {
+                    double best_t, const Vec3& best_normal, SurfaceHit& out, bool& retry) const {
+        retry = false;
         bool found = false;
         double t_max = ray.t_max;
         ShapeHit hit;
@@ -567,8 +573,12 @@ struct Accelerator::Impl {
                 const TriangleMesh& mesh = scene.meshes[mesh_of_geometry[geom]];
                 const uint32_t* index = &mesh.indices[3 * size_t(prim)];
                 const Vec3 v0 = vertex(mesh, index[0]), v1 = vertex(mesh, index[1]), v2 = vertex(mesh, index[2]);
-                if (!intersect_triangle(v0, v1, v2, ray, ray.t_min, ray.t_max, hit) &&
-                    !hit_triangle_plane(v0, v1, v2, ray, hit)) {
+                const bool inside = intersect_triangle(v0, v1, v2, ray, ray.t_min, ray.t_max, hit);
+                if (!inside && hit_triangle_plane(v0, v1, v2, ray, hit) && !(hit.t > ray.t_min && hit.t < ray.t_max)) {
+                    retry = true;
+                    return false;
+                }
+                if (!inside && !hit_triangle_plane(v0, v1, v2, ray, hit)) {
                     // Float and double disagree on an edge: the hit is taken where the double ray
                     // meets the triangle's plane (hit_triangle_plane), not from Embree's float
                     // numbers, which differ in the last bits from one instruction set to another.
@@ -608,18 +618,34 @@ struct Accelerator::Impl {
         return found;
     }
 
-    bool intersect(const Ray& ray, SurfaceHit& out) const {
-        QueryContext context(&ray, nullptr, 1, false);
-        context.best_t[0] = ray.t_max;
-        RTCRayHit rayhit;
-        rayhit.ray = make_embree_ray(ray, 0, frame);
-        rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(rtc_scene, &context.embree, &rayhit);
-        return finish_hit(ray, rayhit.hit.geomID, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v, rayhit.ray.tfar,
-                          {rayhit.hit.Ng_x, rayhit.hit.Ng_y, rayhit.hit.Ng_z}, context.best_t[0],
-                          context.best_normal[0], out);
+    bool intersect(const Ray& ray, SurfaceHit& out) const { return intersect_beyond(ray, -1.0f, out); }
+
+    /// intersect(), with Embree's float range starting past `rejected` (a candidate distance
+    /// finish_hit refused; negative: none). Embree returns its nearest candidate, so every
+    /// other candidate lies at or past that float distance, and starting just past it loses
+    /// none but exact ties. The double range, and the planes, are still decided against `ray`.
+    bool intersect_beyond(const Ray& ray, float rejected, SurfaceHit& out) const {
+        for (int attempt = 0;; ++attempt) {
+            QueryContext context(&ray, nullptr, 1, false);
+            context.best_t[0] = ray.t_max;
+            RTCRayHit rayhit;
+            rayhit.ray = make_embree_ray(ray, 0, frame);
+            if (rejected >= 0) rayhit.ray.tnear = std::max(rayhit.ray.tnear, std::nextafter(rejected, INFINITY));
+            rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            rtcIntersect1(rtc_scene, &context.embree, &rayhit);
+            bool retry = false;
+            const bool found = finish_hit(ray, rayhit.hit.geomID, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v,
+                                          rayhit.ray.tfar, {rayhit.hit.Ng_x, rayhit.hit.Ng_y, rayhit.hit.Ng_z},
+                                          context.best_t[0], context.best_normal[0], out, retry);
+            // A bounded number of refusals in a row (a fan of grazing neighbours); past it the
+            // planes alone answer, as if the triangles had been missed.
+            if (!retry) return found;
+            rejected = rayhit.ray.tfar;
+            if (attempt == max_refused_candidates) return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, 0, 0, 0, 0, {}, 0, {}, out, retry);
+        }
     }
+    static constexpr int max_refused_candidates = 8;
 
     /// Calls `lanes.operator()<W>(first)` for first = 0, W, 2W, ... < count, with W the native
     /// lane_width, so that each packet query is written once for every width. False when
@@ -671,10 +697,12 @@ struct Accelerator::Impl {
         for (int lane = 0; lane < W; ++lane) {
             const int i = first + lane;
             if (!valid[lane]) continue;
+            bool retry = false;
             found[i] = finish_hit(rays[i], packet.hit.geomID[lane], packet.hit.primID[lane], packet.hit.u[lane],
                                   packet.hit.v[lane], packet.ray.tfar[lane],
                                   {packet.hit.Ng_x[lane], packet.hit.Ng_y[lane], packet.hit.Ng_z[lane]},
-                                  context.best_t[i], context.best_normal[i], hits[i]);
+                                  context.best_t[i], context.best_normal[i], hits[i], retry);
+            if (retry) found[i] = intersect_beyond(rays[i], packet.ray.tfar[lane], hits[i]);
         }
     }
 
