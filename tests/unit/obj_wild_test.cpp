@@ -3,6 +3,8 @@
 // mark, Latin-1 names, numbers too small for a float, `mtllib` with several files, undefined
 // materials and faces without any. Areas are closed-form; messages keep FILE:LINE:COL.
 
+#include "whitted/render/accelerator.h"
+#include "whitted/render/renderer.h"
 #include "whitted/scene/mesh_file.h"
 #include "whitted/scene/scene.h"
 
@@ -240,6 +242,40 @@ TEST(ObjWild, ConcaveFacesAreCutIntoEarsForEveryNumberOfRuns) {
         EXPECT_EQ(in_runs.indices, whole.indices) << parts;
         EXPECT_EQ(in_runs.positions, whole.positions) << parts;
     }
+}
+
+// The render of a comb-shaped face, seen straight on by an orthographic camera, ambient light
+// only: the pixels it covers are its area over a pixel's, give or take one pixel along its
+// outline. (The fan from its first corner would also fill the two gaps between the teeth,
+// 6 of its 20 square units: 9600 pixels more, far beyond that.)
+TEST(ObjWild, RenderOfAConcaveFaceCoversItsArea) {
+    const test::ScratchDirectory directory;
+    const std::vector<Point2> teeth = comb(3);  // 5 wide, 4 high, area 14
+    std::string obj;
+    for (const Point2& p : teeth) obj += "v " + std::to_string(p.x) + " " + std::to_string(p.y) + " 0\n";
+    obj += "f";
+    for (size_t i = 1; i <= teeth.size(); ++i) obj += " " + std::to_string(i);
+    directory.write("comb.obj", obj + "\n");
+    const int pixels = 240;
+    const double view_width = 6.0, pixel = view_width / pixels;
+    const Scene scene = test::scene_from(
+        test::join_lines({"camera: {type: orthographic, eye: [2.5, 2, 10], look_at: [2.5, 2, 0], view_width: 6}",
+                          "image: {width: 240, height: 240}", "ambient: 1",
+                          "objects: [{type: mesh, file: comb.obj, material: {ka: 1}}]"}),
+        (directory.path() / "scene.yaml").string());
+    const Accelerator accelerator(scene, 1);
+    RenderOptions options;
+    options.threads = 2;
+    const RenderResult result = render(scene, accelerator, options);
+    int covered = 0;
+    for (int j = 0; j < pixels; ++j)
+        for (int i = 0; i < pixels; ++i) covered += result.image.pixel(i, j)[0] > 0;
+    double perimeter = 0;
+    for (size_t k = 0; k < teeth.size(); ++k) {
+        const Point2 a = teeth[k], b = teeth[(k + 1) % teeth.size()];
+        perimeter += std::hypot(b.x - a.x, b.y - a.y);
+    }
+    EXPECT_NEAR(covered, 14.0 / (pixel * pixel), perimeter / pixel);
 }
 
 TEST(ObjWild, Utf8ByteOrderMarkIsSkipped) {
