@@ -278,6 +278,23 @@ TEST(ObjWild, RenderOfAConcaveFaceCoversItsArea) {
     EXPECT_NEAR(covered, 14.0 / (pixel * pixel), perimeter / pixel);
 }
 
+// An arrowhead quad (area 1.5, the reflex corner (1, 0.5)) from each of its corners: the fan
+// is right only from the reflex corner or the one opposite it; quads take a shortcut of their own.
+TEST(ObjWild, ArrowheadQuadFromEveryCorner) {
+    const std::vector<Point2> arrow = {{0, 0}, {1, 0.5}, {2, 0}, {1, 2}};
+    const test::ScratchDirectory directory;
+    for (size_t start = 0; start < 4; ++start) {
+        std::string text;
+        for (size_t k = 0; k < 4; ++k) {
+            const Point2 p = arrow[(start + k) % 4];
+            text += "v " + std::to_string(p.x) + " " + std::to_string(p.y) + " 0\n";
+        }
+        const MeshData mesh = load_obj_mesh(directory.write("arrow.obj", text + "f 1 2 3 4\n"), {}, 1, false);
+        ASSERT_EQ(mesh.indices.size(), 6u);
+        EXPECT_NEAR(mesh_area(mesh), 1.5, 1e-6) << "starting at corner " << start;
+    }
+}
+
 TEST(ObjWild, Utf8ByteOrderMarkIsSkipped) {
     const test::ScratchDirectory directory;
     const std::string path = directory.write("bom.obj", "\xEF\xBB\xBFv 1 2 3\nv 4 5 6\nv 7 8 10\nf 1 2 3\n");
