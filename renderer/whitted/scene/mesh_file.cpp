@@ -5,14 +5,18 @@
 // lines are read in one pass over the characters; a large file is cut into runs of lines that
 // the cores read at once, after a quick count that says where each run's vertices go.
 //
-// Read: v (x y z, extra values ignored), vn, f (v, v/t, v//n, v/t/n; negative = relative;
-// polygons fanned from their first corner), usemtl, mtllib. Ignored: vt, o, g, s, l, p, and
-// statements it does not know (OBJ has many). MTL: newmtl, Ka, Kd, Ks, Ns, illum.
+// Read: v (x y z, extra values ignored), vn, f (v, v/t, v//n, v/t/n; negative = relative),
+// usemtl, mtllib. Ignored: vt, o, g, s, l, p, and statements it does not know (OBJ has many).
+// MTL: newmtl, Ka, Kd, Ks, Ns, illum. Polygons: a convex one is fanned from its first corner;
+// any other is cut into ears in its own plane (triangulate_polygon), once all positions are
+// known, since a face may use positions another run of lines reads. Text is bytes: names may
+// hold any (Latin-1 is common), a UTF-8 byte-order mark is skipped, control bytes are refused.
 
 #include "whitted/scene/mesh_file.h"
 
 #include "whitted/scene/text_checks.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -20,6 +24,7 @@
 #include <atomic>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <limits>
@@ -40,6 +45,41 @@ bool is_blank(char c) {
 const char* token_end(const char* p, const char* end) {
     while (p < end && !is_blank(*p) && *p != '\n') ++p;
     return p;
+}
+
+/// OBJ and MTL have no encoding: keywords and numbers are ASCII, and names are whatever bytes
+/// the exporter wrote (Latin-1 from older tools, UTF-8 from newer). So any byte is accepted but
+/// NUL and the control bytes no text has (all below 0x20 but tab, line feed, vertical tab, form
+/// feed and carriage return), which mark a binary file; the first is named by line and column.
+/// Called only for text with a byte outside plain ASCII (is_plain_ascii), as a binary file has.
+void check_text_bytes(std::string_view text, const std::string& path) {
+    int line = 1, column = 1;
+    for (const char ch : text) {
+        const auto c = static_cast<unsigned char>(ch);
+        if (c == '\n') {
+            ++line, column = 1;
+            continue;
+        }
+        if (c == 0) throw InputError({path, line, column}, "the file contains a NUL byte: is it a binary file?");
+        if (c < 0x20 && c != '\t' && c != '\v' && c != '\f' && c != '\r') {
+            char hex[8];
+            std::snprintf(hex, sizeof hex, "0x%02X", unsigned(c));
+            throw InputError({path, line, column},
+                             std::string("the file contains the control byte ") + hex + ": is it a binary file?");
+        }
+        ++column;
+    }
+}
+
+/// The text without a leading UTF-8 byte-order mark (some Windows tools write one; it is not
+/// part of the first statement). A UTF-16 file is refused: every other byte would be NUL.
+std::string_view without_byte_order_mark(std::string_view text, const std::string& path) {
+    if (text.substr(0, 3) == "\xEF\xBB\xBF") return text.substr(3);
+    if (text.substr(0, 2) == "\xFE\xFF" || text.substr(0, 2) == "\xFF\xFE")
+        throw InputError({path, 1, 1},
+                         "the file is UTF-16 text; OBJ and MTL files are read as bytes (ASCII, UTF-8 "
+                         "or Latin-1): convert it first, e.g. iconv -f UTF-16 -t UTF-8");
+    return text;
 }
 
 /// Reads the common OBJ number ("-0.123456", "12", "1.5e-3") at p and returns where it ends, or
@@ -83,13 +123,67 @@ bool parse_plain_decimal(std::string_view t, float& out) {
     return scan_plain_decimal(t.data(), t.data() + t.size(), out) == t.data() + t.size();
 }
 
-/// Any finite float std::from_chars reads as the whole token (a leading '+' allowed); false
-/// for everything the caller must refuse.
+/// Any finite float std::from_chars reads as the whole token (a leading '+' allowed), the
+/// nearest float; a value too small for a float (1e-50, even 1e-400) is its nearest float, a
+/// subnormal or 0, as every C library's strtof gives it. False for everything the caller must
+/// refuse (not a number, or beyond float range).
 bool parse_any_float(std::string_view t, float& out) {
     if (t.empty()) return false;
     const char* begin = t.data() + (t.front() == '+' ? 1 : 0);
-    const auto [stop, error] = std::from_chars(begin, t.data() + t.size(), out);
-    return error == std::errc() && stop == t.data() + t.size() && std::isfinite(out);
+    const char* const end = t.data() + t.size();
+    const auto [stop, error] = std::from_chars(begin, end, out);
+    if (stop != end) return false;
+    if (error == std::errc()) return std::isfinite(out);
+    if (error != std::errc::result_out_of_range) return false;
+    // Out of float range: too large (refused), or too small (underflow: the nearest float). A
+    // double tells them apart, and for what is out of double range too the exponent's sign.
+    double wide = 0;
+    const auto [wide_stop, wide_error] = std::from_chars(begin, end, wide);
+    if (wide_stop != end) return false;
+    if (wide_error == std::errc()) {
+        out = float(wide);  // underflows to a subnormal or ±0; a finite double beyond float is refused
+        return std::isfinite(out);
+    }
+    const std::string_view digits(begin, size_t(end - begin));
+    const size_t e = digits.find_first_of("eE");
+    const bool tiny = e != std::string_view::npos && e + 1 < digits.size() && digits[e + 1] == '-';
+    if (!tiny) return false;
+    out = digits.front() == '-' ? -0.0f : 0.0f;
+    return true;
+}
+
+/// "1 vertex", "8 vertices": a count and its noun ("vertex", "normal", "triangle", ...).
+std::string count_of(int64_t count, const std::string& noun) {
+    std::string plural = noun == "vertex" ? "vertices" : noun + "s";
+    return std::to_string(count) + " " + (count == 1 ? noun : plural);
+}
+
+/// A name (material, file) for a message, in quotes: printable ASCII and valid UTF-8 as they
+/// are, every other byte (Latin-1 letters, control bytes) as \xHH, so that a message is
+/// always valid text whatever bytes the file had.
+std::string quote_name(std::string_view name) {
+    static const char hex[] = "0123456789ABCDEF";
+    std::string out = "'";
+    const auto* bytes = reinterpret_cast<const unsigned char*>(name.data());
+    for (size_t i = 0; i < name.size();) {
+        const unsigned char c = bytes[i];
+        // Bytes after c that a valid UTF-8 character starting with c has (0: not such a start).
+        size_t extra = (c & 0xE0) == 0xC0 && c >= 0xC2   ? 1
+                       : (c & 0xF0) == 0xE0              ? 2
+                       : (c & 0xF8) == 0xF0 && c <= 0xF4 ? 3
+                                                         : 0;
+        for (size_t k = 1; extra > 0 && k <= extra; ++k)
+            if (i + k >= name.size() || (bytes[i + k] & 0xC0) != 0x80) extra = 0;
+        if (extra > 0) {
+            out.append(name.substr(i, extra + 1));
+            i += extra + 1;
+        } else if (c >= 0x20 && c < 0x7F && c != '\\') {
+            out += char(c), ++i;
+        } else {
+            out += "\\x", out += hex[c >> 4], out += hex[c & 15], ++i;
+        }
+    }
+    return out + "'";
 }
 
 /// Reads an OBJ index ("12", "-3") at p and returns where it ends, or nullptr when there is none.
@@ -138,18 +232,22 @@ public:
     float parse_float(std::string_view t, const char* what) const {
         float value = 0;
         if (parse_plain_decimal(t, value) || parse_any_float(t, value)) return value;
+        // Why not: a number beyond float range (or inf, nan), or no number at all.
         const char* begin = t.data() + (t.front() == '+' ? 1 : 0);
-        const auto [end, error] = std::from_chars(begin, t.data() + t.size(), value);
-        if (error == std::errc::result_out_of_range || (error == std::errc() && !std::isfinite(value)))
-            fail(std::string(what) + " must be a finite number, got '" + std::string(t) + "'");
-        if (error != std::errc() || end != t.data() + t.size())
-            fail(std::string("expected ") + what + ", got '" + std::string(t) + "'");
-        return value;
+        double wide = 0;
+        const auto [end, error] = std::from_chars(begin, t.data() + t.size(), wide);
+        if (end == t.data() + t.size() && (error == std::errc::result_out_of_range || error == std::errc()))
+            fail(std::string(what) + " must be a finite number within float range (about 3.4e38), got " +
+                 quote_name(t));
+        fail(std::string("expected ") + what + ", got " + quote_name(t));
     }
 
     [[noreturn]] void fail(const std::string& message) const {
         throw InputError({m_path, m_line_number, int(m_token_start) + 1}, message);
     }
+
+    /// The column (from 1) where the last token, or rest(), began.
+    size_t token_column() const { return m_token_start + 1; }
 
 private:
     const std::string& m_path;
@@ -186,13 +284,15 @@ Color read_color(LineReader& line, const char* what) {
 
 void read_mtl(const std::string& path, std::vector<MaterialDescription>& materials,
               std::unordered_map<std::string, int32_t>& by_name) {
-    const std::string text = read_text_file(path, limits::max_mesh_file_bytes, "MTL file");
-    check_text_is_readable(text, path);
+    const std::string file_text = read_text_file(path, limits::max_mesh_file_bytes, "MTL file");
+    const std::string_view text = without_byte_order_mark(file_text, path);
+    if (!is_plain_ascii(text)) check_text_bytes(text, path);
     MaterialDescription* current = nullptr;
     for_each_statement(path, text, [&](LineReader& line, std::string_view keyword) {
         if (keyword == "newmtl") {
+            // Any bytes, spaces inside included; even none (Blender writes `newmtl ` for an
+            // unnamed material, and `usemtl ` then picks it).
             const std::string name(line.rest());
-            if (name.empty()) line.fail("newmtl needs a name");
             MaterialDescription material;
             material.name = name;
             material.where = {path};
@@ -283,6 +383,30 @@ struct Lines {
     }
 };
 
+/// A face of more than three corners: its first triangle (in its run, or in the mesh once
+/// joined) and how many corners it has; its n − 2 triangles follow one another.
+struct Polygon {
+    size_t first_triangle;
+    uint32_t corners;
+    int line;
+};
+
+/// A file `mtllib` names: its path, the name as written, where, and whether it exists.
+struct MtlFile {
+    std::string path, name;
+    SourceLocation where;
+    bool exists;
+};
+
+/// What reading an OBJ file gives besides the triangles: what the materials are resolved from.
+struct ObjContents {
+    MeshData mesh;
+    std::vector<std::pair<std::string, SourceLocation>> usemtl_names;
+    std::vector<MtlFile> mtl_files;
+    size_t lines_and_points = 0;
+    int first_face_line_without_material = 0;  ///< 0: every face follows a usemtl
+};
+
 /// Reads the statements of one run of lines. Positions and normals go straight to their place
 /// in the mesh's arrays (the count says how many come before); faces are kept here and joined
 /// in file order afterwards. Lines the fast path does not recognise as plain `v`, `vn` or `f`
@@ -338,10 +462,19 @@ public:
     /// 3 per triangle; empty while every corner so far names the normal with its position's
     /// number (the usual export), which then needs no copy, and once a corner has no normal.
     std::vector<uint32_t> normal_index;
-    std::vector<int32_t> face_material;  ///< 1 per triangle
+    std::vector<int32_t> face_material;  ///< 1 per triangle: index into usemtl_names, −1 = none
     bool every_corner_has_normal = true;
     bool normals_follow_positions = true;
     size_t positions_read = 0, normals_read = 0;
+    size_t lines_and_points = 0;  ///< `l` and `p` statements, which are not drawn
+    int first_face_line_without_material = 0;
+    /// Faces of more than 3 corners, fanned for now: triangulate_polygons looks at each again
+    /// once every position is known.
+    std::vector<Polygon> polygons;
+    /// The names `usemtl` gave, each with where it was first given; resolved against the MTL
+    /// files once the whole file is read (mtllib may come after usemtl).
+    std::vector<std::pair<std::string, SourceLocation>> usemtl_names;
+    std::vector<MtlFile> mtl_files;  ///< in mtllib order
 
 private:
     static constexpr uint32_t no_normal = std::numeric_limits<uint32_t>::max();
@@ -439,7 +572,9 @@ private:
                 normal_index = position_index;  // until now they were the same
             }
         }
-        for (int k = 1; k + 1 < corners; ++k) {  // fan from the first corner
+        if (m_current_material < 0 && !first_face_line_without_material) first_face_line_without_material = line_number;
+        if (corners > 3) polygons.push_back({face_material.size(), uint32_t(corners), line_number});
+        for (int k = 1; k + 1 < corners; ++k) {  // fan from the first corner (see triangulate_polygons)
             for (const int c : {0, k, k + 1}) {
                 position_index.push_back(positions[c]);
                 if (keep_normals && !normals_follow_positions) normal_index.push_back(normals[c]);
@@ -470,18 +605,17 @@ private:
             read_face_slowly(line, line_number);
         } else if (keyword == "usemtl" || keyword == "mtllib") {
             if (!m_materials_into) throw std::logic_error("OBJ reader: materials in a parallel run");
+            const std::string name(line.rest());  // any bytes, spaces inside included
+            const SourceLocation where{m_path, line_number, int(line.token_column())};
             if (keyword == "usemtl") {
-                const auto it = m_material_by_name.find(std::string(line.rest()));
-                m_current_material = it == m_material_by_name.end() ? -1 : it->second;
+                const auto [it, added] = m_usemtl_index.try_emplace(name, int32_t(usemtl_names.size()));
+                if (added) usemtl_names.emplace_back(name, where);
+                m_current_material = it->second;
             } else {
-                const std::string name(line.rest());
-                const std::filesystem::path mtl = std::filesystem::path(m_path).parent_path() / name;
-                // A missing MTL is not fatal: faces then have no material, which is an error
-                // only when the scene gives none either (validate.cpp says so).
-                std::error_code error;
-                if (!name.empty() && std::filesystem::is_regular_file(mtl, error))
-                    read_mtl(mtl.string(), m_materials_into->materials, m_material_by_name);
+                add_mtl_files(name, where);
             }
+        } else if (keyword == "l" || keyword == "p") {
+            ++lines_and_points;
         }
         return next;
     }
@@ -501,7 +635,7 @@ private:
                 const int64_t written = index;
                 if (!resolve(index, count))
                     line.fail("face refers to " + std::string(what) + " " + std::to_string(written) + ", but " +
-                              std::to_string(count) + " " + what + (count == 1 ? "" : "s") + " are defined before it");
+                              count_of(count, what) + (count == 1 ? " is" : " are") + " defined before it");
                 return uint32_t(index);
             };
             const size_t slash = t.find('/');
@@ -523,9 +657,240 @@ private:
     size_t m_positions_before, m_normals_before, m_faces_before;
     Output m_out;
     MeshData* m_materials_into;  ///< where MTL materials go; null in a run read in parallel
-    std::unordered_map<std::string, int32_t> m_material_by_name;
+    std::unordered_map<std::string, int32_t> m_usemtl_index;  ///< name → index into usemtl_names
     int32_t m_current_material = -1;
+
+    /// `mtllib` takes a list of file names separated by blanks, but exporters also write one name
+    /// with spaces in it: the rest of the line is one file name if a file of that name exists
+    /// beside the OBJ file, otherwise it is split at blanks.
+    void add_mtl_files(const std::string& rest, const SourceLocation& where) {
+        const std::filesystem::path folder = std::filesystem::path(m_path).parent_path();
+        const auto exists = [&](const std::string& name) {
+            std::error_code error;
+            return !name.empty() && std::filesystem::is_regular_file(folder / name, error);
+        };
+        if (rest.empty()) return;
+        if (exists(rest)) {
+            mtl_files.push_back({(folder / rest).string(), rest, where, true});
+            return;
+        }
+        size_t begin = 0;
+        while (begin < rest.size()) {
+            while (begin < rest.size() && is_blank(rest[begin])) ++begin;
+            size_t end = begin;
+            while (end < rest.size() && !is_blank(rest[end])) ++end;
+            if (end > begin) {
+                const std::string name = rest.substr(begin, end - begin);
+                mtl_files.push_back({(folder / name).string(),
+                                     name,
+                                     {where.file, where.line, where.column + int(begin)},
+                                     exists(name)});
+            }
+            begin = end;
+        }
+    }
 };
+
+/// The polygon in its own plane: the normal by Newell's method (the sum over the edges, which
+/// is the polygon's vector area and stays right for any corner order, collinear and repeated
+/// corners included), then the corners projected onto the coordinate plane most nearly
+/// perpendicular to it, mirrored if need be so that the polygon runs anticlockwise.
+struct PlanarPolygon {
+    std::vector<double> u, v;
+
+    PlanarPolygon() = default;
+    explicit PlanarPolygon(const std::vector<Vec3>& corners) { set(corners); }
+
+    /// Takes these corners (the storage is kept from one polygon to the next).
+    void set(const std::vector<Vec3>& corners) {
+        const size_t n = corners.size();
+        Vec3 normal;
+        // Relative to the first corner: coordinates far from the origin then lose no digits.
+        const Vec3 origin = corners.empty() ? Vec3() : corners[0];
+        for (size_t i = 0; i < n; ++i) {
+            const Vec3 a = corners[i] - origin, b = corners[(i + 1) % n] - origin;
+            normal += Vec3{(a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y)};
+        }
+        const int axis = std::fabs(normal.x) >= std::fabs(normal.y) && std::fabs(normal.x) >= std::fabs(normal.z) ? 0
+                         : std::fabs(normal.y) >= std::fabs(normal.z)                                             ? 1
+                                                                                                                  : 2;
+        // Dropping x keeps (y, z), dropping y (z, x), dropping z (x, y): each pair is right-handed
+        // about the dropped axis, so the area there has the sign of that normal component.
+        const int first = (axis + 1) % 3, second = (axis + 2) % 3;
+        const double mirror = normal[axis] < 0 ? -1.0 : 1.0;
+        u.resize(n), v.resize(n);
+        for (size_t i = 0; i < n; ++i) {
+            const Vec3 p = corners[i] - origin;
+            u[i] = mirror * p[first];
+            v[i] = p[second];
+        }
+    }
+
+    /// Twice the signed area of the triangle (a, b, c): > 0 when it turns left (anticlockwise).
+    double turn(size_t a, size_t b, size_t c) const {
+        return (u[b] - u[a]) * (v[c] - v[a]) - (v[b] - v[a]) * (u[c] - u[a]);
+    }
+
+    /// Whether corner p lies inside the triangle (a, b, c), which turns left, or on its edges.
+    bool in_triangle(size_t p, size_t a, size_t b, size_t c) const {
+        return turn(a, b, p) >= 0 && turn(b, c, p) >= 0 && turn(c, a, p) >= 0;
+    }
+
+    bool same_point(size_t a, size_t b) const { return u[a] == u[b] && v[a] == v[b]; }
+
+    /// No corner turns right: the fan from any corner covers the polygon exactly once.
+    bool is_convex() const {
+        const size_t n = u.size();
+        for (size_t i = 0; i < n; ++i)
+            if (turn((i + n - 1) % n, i, (i + 1) % n) < 0) return false;
+        return true;
+    }
+};
+
+/// Reads the MTL files and gives every triangle its material: the one its `usemtl` names, or the
+/// default one (with a warning) where there is none to give: no usemtl before the face, an
+/// empty name, or a name while the OBJ file names no MTL file at all (then the names are only
+/// labels). A name that the MTL files do not define is an error at that usemtl, saying why.
+void resolve_materials(const std::string& path, ObjContents& contents) {
+    MeshData& mesh = contents.mesh;
+    std::unordered_map<std::string, int32_t> by_name;
+    std::vector<const MtlFile*> missing;
+    std::string read_names;  // "a.mtl, b.mtl" for messages
+    for (const MtlFile& mtl : contents.mtl_files) {
+        if (!mtl.exists) {
+            missing.push_back(&mtl);
+            continue;
+        }
+        read_mtl(mtl.path, mesh.materials, by_name);
+        read_names += (read_names.empty() ? "" : ", ") + quote_name(mtl.name);
+    }
+    std::vector<std::string> defined;
+    for (const MaterialDescription& m : mesh.materials) defined.push_back(m.name);
+
+    constexpr int32_t use_default = -2;
+    std::vector<int32_t> material_of(contents.usemtl_names.size());
+    std::vector<std::string> why_default(contents.usemtl_names.size());
+    for (size_t k = 0; k < contents.usemtl_names.size(); ++k) {
+        const auto& [name, where] = contents.usemtl_names[k];
+        const auto it = by_name.find(name);
+        if (it != by_name.end()) {
+            material_of[k] = it->second;
+            continue;
+        }
+        material_of[k] = use_default;
+        if (name.empty()) {
+            why_default[k] = where.str() + ": usemtl without a name, and no MTL material has the empty name";
+        } else if (contents.mtl_files.empty()) {
+            why_default[k] = where.str() + ": usemtl " + quote_name(name) + ", but the file names no MTL file (mtllib)";
+        } else {
+            std::string message = "material " + quote_name(name) + " is not defined";
+            if (!read_names.empty()) message += " in " + read_names;
+            for (const MtlFile* mtl : missing)
+                message += std::string(message.find(": the MTL file") == std::string::npos ? ": " : "; ") +
+                           "the MTL file " + quote_name(mtl->name) + " (mtllib at " + mtl->where.str() +
+                           ") was not found";
+            // did_you_mean writes the name as it is: quote it like the rest of the message.
+            const std::string suggestion = did_you_mean(name, defined), head = " (did you mean '";
+            if (suggestion.size() > head.size() + 3)
+                message += " (did you mean " +
+                           quote_name(suggestion.substr(head.size(), suggestion.size() - head.size() - 3)) + "?)";
+            throw InputError(where, message);
+        }
+    }
+    size_t default_triangles = 0;
+    std::vector<size_t> default_triangles_of(contents.usemtl_names.size(), 0);
+    size_t without_usemtl = 0;
+    for (int32_t& m : mesh.triangle_material) {
+        if (m >= 0 && material_of[size_t(m)] >= 0) {
+            m = material_of[size_t(m)];
+            continue;
+        }
+        m >= 0 ? ++default_triangles_of[size_t(m)] : ++without_usemtl;
+        ++default_triangles;
+        m = int32_t(mesh.materials.size());  // the default material, added below
+    }
+    if (default_triangles == 0) return;
+    MaterialDescription fallback;
+    fallback.name = default_obj_material_name;
+    fallback.where = {path};
+    fallback.kd.value = Color(0.6);
+    mesh.materials.push_back(fallback);
+    const std::string what = "; they get the default material (kd 0.6 grey; ka, ks, km 0)";
+    if (without_usemtl > 0)
+        mesh.warnings.push_back(SourceLocation{path, contents.first_face_line_without_material, 1}.str() +
+                                ": faces without usemtl, from this one on (" +
+                                count_of(int64_t(without_usemtl), "triangle") + ")" + what);
+    for (size_t k = 0; k < contents.usemtl_names.size(); ++k)
+        if (default_triangles_of[k] > 0)
+            mesh.warnings.push_back(why_default[k] + " (" + count_of(int64_t(default_triangles_of[k]), "triangle") +
+                                    ")" + what);
+}
+
+/// Above this many corners a face that is not convex is refused: ear clipping takes time that
+/// grows with the square of the corners (a second at about this size on one core).
+constexpr size_t max_concave_corners = 20000;
+
+/// Looks again at every polygon, fanned while reading: where the fan is wrong (the polygon is
+/// not convex) its n − 2 triangles are replaced by triangulate_polygon's, in place. The
+/// polygons are independent, so the cores share them; the result does not depend on how.
+void triangulate_polygons(const std::string& path, const std::vector<float>& positions,
+                          const std::vector<Polygon>& polygons, std::vector<uint32_t>& indices,
+                          std::vector<uint32_t>& normal_index) {
+    if (polygons.empty()) return;
+    std::atomic<size_t> first_refused{polygons.size()};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, polygons.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<uint32_t> position_of, normal_of;
+        std::vector<Vec3> corners;
+        PlanarPolygon plane;
+        for (size_t k = r.begin(); k != r.end(); ++k) {
+            const Polygon& polygon = polygons[k];
+            const size_t n = polygon.corners, t0 = polygon.first_triangle;
+            if (n == 4) {
+                // Quads, most polygons by far, in a few multiplications: the fan's two triangles
+                // (0, 1, 2) and (0, 2, 3) face the same way exactly when corners 1 and 3 lie on
+                // either side of the diagonal from 0 to 2, and then they cover the quad.
+                const auto at = [&](size_t corner) {
+                    const float* xyz = &positions[3 * size_t(indices[corner])];
+                    return Vec3{xyz[0], xyz[1], xyz[2]};
+                };
+                const Vec3 p0 = at(3 * t0), p1 = at(3 * t0 + 1), p2 = at(3 * t0 + 2), p3 = at(3 * t0 + 5);
+                if (dot(cross(p1 - p0, p2 - p0), cross(p2 - p0, p3 - p0)) > 0) continue;
+            }
+            // The fan (0, j, j+1) for j = 1 … n−2 names corner 0, corner 1, then one more each.
+            const auto fan_corners = [&](const std::vector<uint32_t>& index, std::vector<uint32_t>& out) {
+                out.assign({index[3 * t0], index[3 * t0 + 1]});
+                for (size_t j = 0; j + 2 < n; ++j) out.push_back(index[3 * (t0 + j) + 2]);
+            };
+            fan_corners(indices, position_of);
+            corners.resize(n);
+            for (size_t c = 0; c < n; ++c) {
+                const float* xyz = &positions[3 * size_t(position_of[c])];
+                corners[c] = {xyz[0], xyz[1], xyz[2]};
+            }
+            plane.set(corners);
+            if (plane.is_convex()) continue;  // the fan is right
+            if (n > max_concave_corners) {
+                size_t seen = first_refused.load();
+                while (k < seen && !first_refused.compare_exchange_weak(seen, k)) {
+                }
+                continue;
+            }
+            const std::vector<uint32_t> triangles = triangulate_polygon(corners);
+            if (!normal_index.empty()) fan_corners(normal_index, normal_of);
+            for (size_t c = 0; c < triangles.size(); ++c) {
+                indices[3 * t0 + c] = position_of[triangles[c]];
+                if (!normal_index.empty()) normal_index[3 * t0 + c] = normal_of[triangles[c]];
+            }
+        }
+    });
+    if (first_refused < polygons.size()) {
+        const Polygon& polygon = polygons[first_refused];
+        throw InputError({path, polygon.line, 1}, "a face of " + count_of(polygon.corners, "corner") +
+                                                      " that is not convex; Whitted "
+                                                      "triangulates such faces of up to " +
+                                                      std::to_string(max_concave_corners) + " corners");
+    }
+}
 
 /// Splits `text` into at most `parts` runs of whole lines of roughly equal size.
 std::vector<Lines> split_lines(std::string_view text, size_t parts) {
@@ -545,12 +910,12 @@ std::vector<Lines> split_lines(std::string_view text, size_t parts) {
 /// Reads the OBJ text as `parts` runs of lines at once; nullopt when that cannot give the same
 /// result as reading it in one go (usemtl/mtllib, an error anywhere: the caller then reads it in
 /// one go, which words the error for the first bad line).
-std::optional<MeshData> read_obj(const std::string& path, std::string_view text, size_t parts) {
+std::optional<ObjContents> read_obj(const std::string& path, std::string_view text, size_t parts) {
     std::vector<Lines> runs = split_lines(text, parts);
     tbb::parallel_for(size_t(0), runs.size(), [&](size_t k) { runs[k].count(); });
     for (const Lines& run : runs)
         if (!run.plain_ascii) {
-            check_text_is_readable(text, path);  // refuses binary files, names the line
+            check_text_bytes(text, path);  // refuses binary files, names the line
             break;
         }
     const bool parallel = runs.size() > 1;
@@ -561,7 +926,8 @@ std::optional<MeshData> read_obj(const std::string& path, std::string_view text,
     }
     for (size_t k = 1; k < runs.size(); ++k) runs[k].first_line = runs[k - 1].first_line + int(runs[k - 1].newlines);
 
-    MeshData mesh;
+    ObjContents contents;
+    MeshData& mesh = contents.mesh;
     mesh.positions = std::vector<float>(3 * positions);
     std::vector<float> all_normals(3 * normals);
     std::vector<std::unique_ptr<ObjReader>> readers;
@@ -594,18 +960,30 @@ std::optional<MeshData> read_obj(const std::string& path, std::string_view text,
         triangles += readers[k]->face_material.size();
         every_corner_has_normal &= readers[k]->every_corner_has_normal;
         normals_follow_positions &= readers[k]->normals_follow_positions;
+        contents.lines_and_points += readers[k]->lines_and_points;
+        if (!contents.first_face_line_without_material)
+            contents.first_face_line_without_material = readers[k]->first_face_line_without_material;
     }
+    contents.usemtl_names = std::move(readers[0]->usemtl_names);  // only a run read alone has them
+    contents.mtl_files = std::move(readers[0]->mtl_files);
     if (triangles > size_t(limits::max_triangles)) return std::nullopt;  // one go names the line
-    if (triangles == 0) return mesh;                                     // the caller refuses it
+    if (triangles == 0) return contents;                                 // the caller refuses it
 
     // Join the runs' faces in file order.
     std::vector<uint32_t> normal_index;
+    std::vector<Polygon> polygons;
     if (readers.size() == 1) {
         mesh.indices = std::move(readers[0]->position_index);
         mesh.triangle_material = std::move(readers[0]->face_material);
         normal_index = std::move(readers[0]->normal_index);
+        polygons = std::move(readers[0]->polygons);
     } else {
         for (const auto& reader : readers) {
+            const size_t triangles_before = mesh.triangle_material.size();
+            for (Polygon polygon : reader->polygons) {
+                polygon.first_triangle += triangles_before;
+                polygons.push_back(polygon);
+            }
             mesh.indices.insert(mesh.indices.end(), reader->position_index.begin(), reader->position_index.end());
             mesh.triangle_material.insert(mesh.triangle_material.end(), reader->face_material.begin(),
                                           reader->face_material.end());
@@ -616,12 +994,14 @@ std::optional<MeshData> read_obj(const std::string& path, std::string_view text,
         }
     }
 
+    triangulate_polygons(path, mesh.positions, polygons, mesh.indices, normal_index);
+
     const bool smooth = every_corner_has_normal && normals > 0;
-    if (!smooth) return mesh;
+    if (!smooth) return contents;
     if (normals_follow_positions) {
         all_normals.resize(mesh.positions.size(), 0.0f);
         mesh.normals = std::move(all_normals);
-        return mesh;
+        return contents;
     }
     // One vertex per distinct (position, normal) pair, numbered in order of first use, so that
     // normals index like positions. Each position keeps a short chain of the vertices made from it.
@@ -645,12 +1025,74 @@ std::optional<MeshData> read_obj(const std::string& path, std::string_view text,
         }
         mesh.indices[c] = vertex;
     }
-    return mesh;
+    return contents;
 }
 
 }  // namespace
 
-MeshData load_obj_mesh(const std::string& path, const SourceLocation& referenced_at, int parts) {
+bool is_convex_polygon(const std::vector<Vec3>& corners) {
+    return PlanarPolygon(corners).is_convex();
+}
+
+std::vector<uint32_t> triangulate_polygon(const std::vector<Vec3>& corners) {
+    const size_t n = corners.size();
+    std::vector<uint32_t> triangles;
+    if (n < 3) return triangles;
+    triangles.reserve(3 * (n - 2));
+    const PlanarPolygon polygon(corners);
+    if (polygon.is_convex()) {
+        for (size_t k = 1; k + 1 < n; ++k) triangles.insert(triangles.end(), {0, uint32_t(k), uint32_t(k + 1)});
+        return triangles;
+    }
+    // Ear clipping: a corner whose triangle with its two neighbours turns left and holds no other
+    // corner is an ear; cutting it off leaves a polygon of one corner fewer that covers the rest.
+    // Corners that turn neither way (collinear, or repeated) are cut first: their triangle covers
+    // nothing, and they would otherwise make their neighbours look like non-ears. A simple polygon
+    // always has an ear (two, in fact); should none be found (the polygon crosses itself) the
+    // corner that turns left most is cut, so that every polygon still gets its n − 2 triangles.
+    std::vector<size_t> previous(n), next(n);
+    for (size_t i = 0; i < n; ++i) previous[i] = (i + n - 1) % n, next[i] = (i + 1) % n;
+    const auto cut = [&](size_t i) {
+        triangles.insert(triangles.end(), {uint32_t(previous[i]), uint32_t(i), uint32_t(next[i])});
+        next[previous[i]] = next[i];
+        previous[next[i]] = previous[i];
+    };
+    const auto is_ear = [&](size_t i) {
+        const size_t a = previous[i], c = next[i];
+        if (polygon.turn(a, i, c) <= 0) return false;
+        // Only a corner that does not turn left can lie inside an ear of a simple polygon; one
+        // at the same place as a corner of the ear (a polygon with a slit to a hole) does not count.
+        for (size_t p = next[c]; p != a; p = next[p]) {
+            if (polygon.turn(previous[p], p, next[p]) > 0) continue;
+            if (polygon.same_point(p, a) || polygon.same_point(p, i) || polygon.same_point(p, c)) continue;
+            if (polygon.in_triangle(p, a, i, c)) return false;
+        }
+        return true;
+    };
+    size_t remaining = n, i = 0;
+    while (remaining > 3) {
+        size_t chosen = n;
+        // A corner that covers nothing, else the first ear from where the last cut was.
+        for (size_t k = 0, j = i; k < remaining && chosen == n; ++k, j = next[j])
+            if (polygon.turn(previous[j], j, next[j]) == 0) chosen = j;
+        for (size_t k = 0, j = i; k < remaining && chosen == n; ++k, j = next[j])
+            if (is_ear(j)) chosen = j;
+        if (chosen == n) {  // not a simple polygon: the sharpest left turn
+            double best = -std::numeric_limits<double>::infinity();
+            for (size_t k = 0, j = i; k < remaining; ++k, j = next[j]) {
+                const double t = polygon.turn(previous[j], j, next[j]);
+                if (t > best) best = t, chosen = j;
+            }
+        }
+        i = next[chosen];
+        cut(chosen);
+        --remaining;
+    }
+    triangles.insert(triangles.end(), {uint32_t(previous[i]), uint32_t(i), uint32_t(next[i])});
+    return triangles;
+}
+
+MeshData load_obj_mesh(const std::string& path, const SourceLocation& referenced_at, int parts, bool need_materials) {
     std::error_code error;
     const auto status = std::filesystem::status(path, error);
     if (error || !std::filesystem::exists(status))
@@ -658,7 +1100,7 @@ MeshData load_obj_mesh(const std::string& path, const SourceLocation& referenced
     if (!std::filesystem::is_regular_file(status))
         throw InputError(referenced_at, "mesh file '" + path + "' is not a regular file");
     const MappedTextFile file(path, limits::max_mesh_file_bytes, "mesh file");
-    const std::string_view text = file.text();
+    const std::string_view text = without_byte_order_mark(file.text(), path);
     // Large files are read by every core at once, a run of lines each (below a few megabytes
     // the threads would cost more than they save).
     if (parts <= 0) {
@@ -666,11 +1108,28 @@ MeshData load_obj_mesh(const std::string& path, const SourceLocation& referenced
         parts = int(std::clamp<size_t>(text.size() / bytes_per_part, 1,
                                        size_t(std::max(1, tbb::this_task_arena::max_concurrency()))));
     }
-    std::optional<MeshData> mesh;
-    if (parts > 1) mesh = read_obj(path, text, size_t(parts));
-    if (!mesh) mesh = read_obj(path, text, 1);
-    if (mesh->indices.empty()) throw InputError(referenced_at, "mesh file '" + path + "' has no faces");
-    return std::move(*mesh);
+    std::optional<ObjContents> contents;
+    if (parts > 1) contents = read_obj(path, text, size_t(parts));
+    if (!contents) contents = read_obj(path, text, 1);
+    MeshData& mesh = contents->mesh;
+    if (mesh.indices.empty()) {
+        std::string why;
+        if (text.find_first_not_of(" \t\r\n\v\f") == std::string_view::npos)
+            why = text.empty() ? ": the file is empty" : ": the file is blank";
+        else if (contents->lines_and_points > 0)
+            why = ": its " + count_of(int64_t(contents->lines_and_points), "line (l) or point (p) statement") +
+                  (contents->lines_and_points == 1 ? " is" : " are") + " not drawn (Whitted renders faces, f)";
+        else if (!mesh.positions.empty())
+            why = ": only vertices (v), no f statements";
+        throw InputError(referenced_at, "mesh file '" + path + "' has no faces" + why);
+    }
+    if (need_materials) {
+        resolve_materials(path, *contents);
+    } else {
+        std::fill(mesh.triangle_material.begin(), mesh.triangle_material.end(), -1);
+    }
+    for (const std::string& warning : mesh.warnings) std::fprintf(stderr, "whitted: warning: %s\n", warning.c_str());
+    return std::move(mesh);
 }
 
 }  // namespace whitted

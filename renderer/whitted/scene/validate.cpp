@@ -149,7 +149,8 @@ private:
         };
         MeshData data;
         try {
-            data = load_obj_mesh(object.file_path, object.file.where);
+            // With the object's own material the MTL files are not needed (nor read).
+            data = load_obj_mesh(object.file_path, object.file.where, 0, !object.material);
         } catch (const InputError& e) {
             if (e.where().file == object.file.where.file) throw;
             throw with_reference(e);
