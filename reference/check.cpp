@@ -139,6 +139,7 @@ CheckResult run_check(const std::string& scene_path, const CheckOptions& options
         const Accelerator accelerator(scene, options.threads);
         RenderOptions render_options;
         render_options.threads = options.threads;
+        render_options.layers = options.layers;
         RenderResult rendered = render(scene, accelerator, render_options);
         result.whitted_seconds = rendered.seconds;
         ours = std::move(rendered.image);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "compare.h"
+#include "whitted/render/layers.h"
 
 #include <atomic>
 #include <stdexcept>
@@ -22,6 +23,9 @@ struct CheckOptions {
     size_t worst_count = 10;  ///< pixels listed by the report
     int threads = 0;
     bool quiet = false;
+    /// Whitted renders with these render layers (docs/layers.md); its beauty, then the float
+    /// sum of the colour layers, is what is compared.
+    LayerSet layers;
     /// When set, POV-Ray is not run: this stored POV-Ray image (its linear 16-bit PNG of the
     /// converted scene, n·W × n·H for image.samples n) is compared instead, at `exposure`, the
     /// exposure it was rendered with (`whitted check` prints and reports it). The image tier
