@@ -153,6 +153,11 @@ std::vector<ImageLayer> make_image_layers(const Scene& scene, LayerSet selection
     return layers;
 }
 
+void PixelLayers::clear() {
+    sum.ambient = sum.diffuse = sum.specular = sum.mirror = sum.background = Color(0.0);
+    for (Color& light : sum.lights) light = Color(0.0);
+}
+
 void PixelLayers::add_sample(const PathLayers& sample, bool first_sample) {
     if (sum.lights.size() != sample.lights.size()) sum.lights.assign(sample.lights.size(), Color(0.0));
     sum.ambient += sample.ambient;

@@ -100,6 +100,8 @@ std::vector<ImageLayer> make_image_layers(const Scene& scene, LayerSet selection
 struct PixelLayers {
     PathLayers sum;    ///< colour terms: summed over the pixel's samples, then averaged by finish()
     PathLayers first;  ///< data terms: the pixel's first sample's
+    /// Back to no samples, keeping the storage (a render calls this once per pixel).
+    void clear();
     void add_sample(const PathLayers& sample, bool first_sample);
     void finish(int samples_per_pixel);
 };

@@ -98,7 +98,7 @@ void render_block_layers_single_sample(const Scene& scene, const LectureShading&
             counts.camera += count;
             for (int k = 0; k < count; ++k) {
                 const size_t index = size_t(pixel_y[k]) * scene.width + pixel_x[k];
-                pixel = PixelLayers();
+                pixel.clear();
                 pixel.add_sample(recorder.lane(k), true);
                 store_pixel_layers(pixel, selection, image.layers, index, &image.rgb[3 * index]);
             }
