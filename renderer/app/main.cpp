@@ -530,6 +530,10 @@ int main(int argc, char** argv) {
         ->check(CLI::NonNegativeNumber);
     check_cmd->add_option("-t,--threads", check_options.threads, "Worker threads for Whitted (default: all cores)");
     check_cmd->add_flag("-q,--quiet", check_options.quiet, "Print only the verdict line");
+    check_cmd->add_flag("--terms", check_options.terms,
+                        "Check term by term: the scene with only ambient, only diffuse, only specular, and each "
+                        "light alone (several lights), each against POV-Ray; the last line names the terms "
+                        "that disagree");
     std::vector<std::string> check_layers;
     check_cmd
         ->add_option("--layers", check_layers,
