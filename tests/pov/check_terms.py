@@ -9,6 +9,8 @@
 2. The same with POV-Ray behind a wrapper that brightens its image by 0.01 only when the scene
    it renders has light 2 alone: exit 1, and the verdict names light 2 as the term that
    disagrees and the others as agreeing. So a failing term is found and named.
+3. examples/meshes/meshes.yaml, whose meshes take their materials from an MTL file: refused,
+   exit 2, naming the object's FILE:LINE:COL, before POV-Ray runs.
 Like the rest of the pov tier, this needs POV-Ray and fails without it."""
 
 import os
@@ -70,6 +72,13 @@ def main():
     if not re.search(r"^FAIL .*\[light 2 only\]", result.stdout, re.M):
         sys.exit(f"FAIL: no FAIL line for light 2:\n{result.stdout}")
     print(f"ok light 2 made to disagree: {last}")
+
+    meshes = os.path.join(scene_dir, "..", "..", "examples", "meshes", "meshes.yaml")
+    result = subprocess.run([whitted, "check", meshes, "--terms", "-q"], capture_output=True, text=True)
+    want = "meshes.yaml:49:9: check --terms: this mesh takes its materials from the MTL file of 'icosphere.obj'"
+    if result.returncode != 2 or want not in result.stderr:
+        sys.exit(f"FAIL: MTL materials: exit {result.returncode}, stderr: {result.stderr}")
+    print("ok MTL materials refused: exit 2 with the object's place")
 
 
 if __name__ == "__main__":
