@@ -363,6 +363,9 @@ def case_usage(whitted, out_dir):
     with open(good_layers_scene, "w") as f:
         f.write(CLOSED_SCENE.replace("version: 1\n", "version: 1\nrender: { layers: [all] }\n"))
     png = os.path.join(out_dir, "usage.png")
+    for stale in [png, os.path.join(out_dir, "u.exr")]:  # an earlier run's files would hide a write
+        if os.path.exists(stale):
+            os.remove(stale)
     cases = [
         ([whitted, "render", scene, "-o", png, "--layers", "all"], "written as channels of an EXR only"),
         ([whitted, "render", good_layers_scene, "-o", png], "render.layers at " + good_layers_scene + ":2:"),
@@ -383,7 +386,10 @@ def case_usage(whitted, out_dir):
         if os.path.exists(path):
             sys.exit(f"FAIL: a refused render wrote {path}")
     # --layers none overrides the scene's render.layers: the PNG is written.
-    run([whitted, "render", good_layers_scene, "-o", png, "-q", "--layers", "none"])
+    written = os.path.join(out_dir, "usage_no_layers.png")
+    run([whitted, "render", good_layers_scene, "-o", written, "-q", "--layers", "none"])
+    if not os.path.exists(written):
+        sys.exit(f"FAIL: --layers none wrote no {written}")
     print(f"ok usage: {len(cases)} refusals with exit 2 and a clear message; --layers none overrides the scene")
 
 
