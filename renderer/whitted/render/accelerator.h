@@ -36,11 +36,11 @@ struct SurfaceHit {
     double t = 0;
     Vec3 point;
     Vec3 normal;  ///< unit shading normal (interpolated for smooth meshes), not yet turned to the ray
-    /// Unit geometric normal: a triangle's face normal (v1 − v0) × (v2 − v0), the sphere's, box
-    /// face's or plane's outward normal; not turned to the ray.
-    Vec3 geometric_normal;
     uint32_t material = 0;
-    uint32_t object = 0;  ///< Scene::objects index + 1 (SceneObject)
+    /// Unit geometric normal: the triangle's face normal ((v1 − v0) × (v2 − v0)), or the
+    /// analytic normal of a sphere, box or plane (the same as `normal` there); not turned.
+    Vec3 geometric_normal;
+    uint32_t object = 0;  ///< Scene::objects index + 1 (SceneObject): the objectId layer
 };
 
 /// Ray queries over a Scene. Embree's BVH finds the candidates (triangles natively, spheres and
