@@ -14,6 +14,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -129,16 +130,20 @@ std::string verdict_line(const std::string& scene_path, const CheckResult& r, co
 }
 
 CheckResult run_check(const std::string& scene_path, const CheckOptions& options) {
+    return run_check(parse_scene_file(scene_path), scene_path, options);
+}
+
+CheckResult run_check(const SceneDescription& description, const std::string& scene_path, const CheckOptions& options) {
     CheckResult result;
 
     // 1. Whitted, exactly as `whitted render` does it.
-    const SceneDescription description = parse_scene_file(scene_path);
     const Scene scene = validate_scene(description);
     Image ours;
     {
         const Accelerator accelerator(scene, options.threads);
         RenderOptions render_options;
         render_options.threads = options.threads;
+        render_options.layers = options.layers;
         RenderResult rendered = render(scene, accelerator, render_options);
         result.whitted_seconds = rendered.seconds;
         ours = std::move(rendered.image);
@@ -242,6 +247,95 @@ CheckResult run_check(const std::string& scene_path, const CheckOptions& options
     std::printf("%s\n", verdict_line(scene_path, result, options).c_str());
     std::fflush(stdout);
     return result;
+}
+
+namespace {
+
+template <class F>
+void for_each_material(std::vector<ObjectDescription>& objects, F&& f) {
+    for (ObjectDescription& object : objects) {
+        if (object.material && object.material->inline_) f(*object.material->inline_);
+        if (object.type == ObjectType::mesh && object.file.given && !object.material)
+            throw InputError(object.where, "check --terms: this mesh takes its materials from the MTL file of '" +
+                                               object.file.value +
+                                               "', which --terms cannot isolate; give it a 'material'");
+        for_each_material(object.children, f);
+    }
+}
+
+/// Applies f to every material of the scene, named or inline.
+template <class F>
+void for_each_material(SceneDescription& scene, F&& f) {
+    for (MaterialDescription& material : scene.materials) f(material);
+    for_each_material(scene.objects, f);
+}
+
+}  // namespace
+
+std::vector<TermScene> term_scenes(const SceneDescription& description) {
+    SceneDescription probe = description;
+    bool any_ka = false, any_kd = false, any_ks = false;
+    for_each_material(probe, [&](MaterialDescription& m) {
+        any_ka |= !is_zero(m.ka.value);
+        any_kd |= !is_zero(m.kd.value);
+        any_ks |= !is_zero(m.ks.value);
+    });
+    const auto keep_only = [&](bool ka, bool kd, bool ks) {
+        SceneDescription variant = description;
+        for_each_material(variant, [&](MaterialDescription& m) {
+            if (!ka) m.ka.value = Color(0.0);
+            if (!kd) m.kd.value = Color(0.0);
+            if (!ks) m.ks.value = Color(0.0);
+            m.km.value = Color(0.0);
+        });
+        return variant;
+    };
+    std::vector<TermScene> terms;
+    if (any_ka && !is_zero(description.ambient.value)) terms.push_back({"ambient", keep_only(true, false, false)});
+    const bool lit = !description.lights.empty();
+    if (lit && any_kd) terms.push_back({"diffuse", keep_only(false, true, false)});
+    if (lit && any_ks) terms.push_back({"specular", keep_only(false, false, true)});
+    if (description.lights.size() > 1 && (any_kd || any_ks))
+        for (size_t k = 0; k < description.lights.size(); ++k) {
+            TermScene light{"light " + std::to_string(k + 1), keep_only(false, true, true)};
+            light.description.lights = {description.lights[k]};
+            terms.push_back(std::move(light));
+        }
+    return terms;
+}
+
+bool run_check_terms(const std::string& scene_path, const CheckOptions& options) {
+    const SceneDescription description = parse_scene_file(scene_path);
+    const std::vector<TermScene> terms = term_scenes(description);
+    if (terms.empty()) throw InputError({scene_path}, "check --terms: the scene has no term to isolate");
+    std::vector<std::string> failed, passed;
+    for (const TermScene& term : terms) {
+        CheckOptions one = options;
+        one.terms = false;
+        if (!options.report_dir.empty()) {
+            std::string folder = term.term;
+            std::replace(folder.begin(), folder.end(), ' ', '_');
+            one.report_dir = (fs::path(options.report_dir) / folder).string();
+        }
+        std::printf("term '%s':\n", term.term.c_str());
+        std::fflush(stdout);
+        const CheckResult result = run_check(term.description, scene_path + " [" + term.term + " only]", one);
+        (result.passed ? passed : failed).push_back(term.term);
+    }
+    const auto list = [](const std::vector<std::string>& names) {
+        std::string text;
+        for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
+        return text;
+    };
+    if (failed.empty())
+        std::printf("whitted check --terms %s: PASS: every term agrees with POV-Ray (%s)\n", scene_path.c_str(),
+                    list(passed).c_str());
+    else
+        std::printf("whitted check --terms %s: FAIL: %s disagree%s with POV-Ray%s\n", scene_path.c_str(),
+                    list(failed).c_str(), failed.size() == 1 ? "s" : "",
+                    passed.empty() ? "" : (" (" + list(passed) + " agree)").c_str());
+    std::fflush(stdout);
+    return failed.empty();
 }
 
 }  // namespace whitted::reference

@@ -2,6 +2,8 @@
 #pragma once
 
 #include "compare.h"
+#include "whitted/render/layers.h"
+#include "whitted/scene/description.h"
 
 #include <atomic>
 #include <stdexcept>
@@ -22,6 +24,11 @@ struct CheckOptions {
     size_t worst_count = 10;  ///< pixels listed by the report
     int threads = 0;
     bool quiet = false;
+    /// Whitted renders with these render layers (docs/layers.md); its beauty, then the float
+    /// sum of the colour layers, is what is compared.
+    LayerSet layers;
+    /// Check term by term (`check --terms`): see run_check_terms.
+    bool terms = false;
     /// When set, POV-Ray is not run: this stored POV-Ray image (its linear 16-bit PNG of the
     /// converted scene, n·W × n·H for image.samples n) is compared instead, at `exposure`, the
     /// exposure it was rendered with (`whitted check` prints and reports it). The image tier
@@ -50,6 +57,23 @@ struct CheckResult {
 /// Renders the scene with Whitted and (converted) with POV-Ray, compares them, prints the
 /// figures and writes the report. Throws InputError / std::runtime_error on errors.
 CheckResult run_check(const std::string& scene_path, const CheckOptions& options);
+/// The same for a description already read; `label` names it in messages and the report.
+CheckResult run_check(const SceneDescription& description, const std::string& label, const CheckOptions& options);
+
+/// One term-isolated variant of a scene (`check --terms`).
+struct TermScene {
+    std::string term;  ///< "ambient", "diffuse", "specular", "light 1", ...
+    SceneDescription description;
+};
+/// The scene with only one term of the equation left, for each term the scene has: ambient
+/// (kd = ks = km = 0), diffuse (ka = ks = km = 0), specular (ka = kd = km = 0), and, with
+/// several lights, each light alone with ka = km = 0. A term no material has (every ks 0, say)
+/// is left out. Throws InputError for a mesh whose materials come from its MTL file (they are
+/// not in the description to change).
+std::vector<TermScene> term_scenes(const SceneDescription& description);
+/// `check --terms`: run_check on every term_scenes variant (reports in report_dir/<term>),
+/// then one line naming the terms that failed. True when all pass.
+bool run_check_terms(const std::string& scene_path, const CheckOptions& options);
 
 /// Writes ours.png, povray.png, diff.png (scaled heat map), ours.exr, povray.exr, diff.exr,
 /// metrics.json and report.html into `dir`. `ours` and `theirs` are the images as compared,

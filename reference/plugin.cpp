@@ -26,6 +26,7 @@ __attribute__((visibility("default"))) int whitted_run_check(const std::string& 
                                                              const whitted::reference::CheckOptions& options,
                                                              const std::atomic<int>& signal) {
     try {
+        if (options.terms) return whitted::reference::run_check_terms(scene_path, options) ? 0 : 1;
         return whitted::reference::run_check(scene_path, options).passed ? 0 : 1;
     } catch (const whitted::reference::Interrupted&) {
         std::fprintf(stderr, "whitted: interrupted; POV-Ray stopped, temporary files removed\n");

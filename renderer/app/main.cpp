@@ -4,6 +4,7 @@
 // (0 ok, 1 failure while rendering or checking, 2 bad input or usage, 130/143 interrupted).
 
 #include "converters/pov_writer.h"
+#include "explain_command.h"
 #include "reference/check.h"
 #include "whitted/output/atomic_files.h"
 #include "whitted/output/color_management.h"
@@ -134,6 +135,7 @@ struct RenderArguments {
     std::string exr_compression;  // empty: not given (none)
     int bit_depth = 0;
     std::string ocio_config, display, view;
+    std::vector<std::string> layers;  // --layers; empty: not given (the scene's render.layers)
 };
 
 OutputOptions output_options(const RenderArguments& args) {
@@ -184,13 +186,32 @@ int run_render(const RenderArguments& args) {
     double parse_seconds = 0, validate_seconds = 0;
     install_signal_handlers();
     OutputOptions output = output_options(args);
+    LayerSet layers;
     try {
         // Usage first, in milliseconds: nothing here reads the scene.
         check_output_path(args.output);
+        if (!args.layers.empty()) {
+            layers = parse_layers(args.layers);
+            if (!layers.empty()) output.layers_from = "--layers";
+        }
         check_output_options(args.output, output);
         refuse_output_over(args.output, args.scene, "scene file");
         const SceneDescription description = parse_scene_file(args.scene);
         parse_seconds = timer.lap();
+        if (args.layers.empty() && !description.layers.empty()) {
+            // The scene's render.layers, unless --layers was given (--layers none turns them off).
+            std::vector<std::string> names;
+            for (const auto& layer : description.layers) names.push_back(layer.value);
+            try {
+                layers = parse_layers(names);
+            } catch (const std::invalid_argument&) {
+                layers = LayerSet();  // validate_scene names the bad entry's place below
+            }
+            if (!layers.empty()) {
+                output.layers_from = "render.layers at " + description.layers.front().where.str();
+                check_output_options(args.output, output);
+            }
+        }
         std::vector<std::string> meshes;
         collect_mesh_files(description.objects, meshes);
         for (const std::string& mesh : meshes) refuse_output_over(args.output, mesh, "mesh file");
@@ -216,6 +237,7 @@ int run_render(const RenderArguments& args) {
         const double build_seconds = timer.lap();
         RenderOptions options;
         options.threads = args.threads;
+        options.layers = layers;
         options.cancel = &g_cancel;
         if (!args.quiet && ::isatty(STDERR_FILENO)) options.on_progress = draw_progress;
         g_exit_on_signal.store(false);  // from here on a signal cancels, and we clean up
@@ -456,6 +478,27 @@ int main(int argc, char** argv) {
     render_cmd->add_flag("--partial", render_args.partial,
                          "If interrupted, still write what was finished (marked partial in the metadata)");
 
+    render_cmd
+        ->add_option(
+            "--layers", render_args.layers,
+            "EXR only: write render layers as extra channels, 'all' or a comma-separated list of: " + layer_choices() +
+                " (docs/layers.md); overrides the scene's render.layers, 'none' turns them off. The "
+                "beauty R, G, B is then the float sum of ambient, diffuse, specular, mirror, background")
+        ->delimiter(',');
+
+    std::string explain_scene, explain_pixel_text;
+    bool explain_json = false;
+    int explain_threads = 0;
+    CLI::App* explain_cmd = app.add_subcommand(
+        "explain", "Print every term of one pixel's equation, as the render computes it (docs/layers.md)");
+    explain_cmd->add_option("scene", explain_scene, "Scene file")->required()->check(CLI::ExistingFile);
+    explain_cmd
+        ->add_option("--pixel", explain_pixel_text, "The pixel: X,Y (column, row from the top-left corner, 0-based)")
+        ->required();
+    explain_cmd->add_flag("--json", explain_json, "Print JSON (docs/explain.schema.json) instead of text");
+    explain_cmd->add_option("-t,--threads", explain_threads, "Threads for building the BVH (default: all cores)")
+        ->check(CLI::Range(0, 4096));
+
     std::string convert_scene, convert_output;
     CLI::App* convert_cmd = app.add_subcommand("convert", "Convert a scene to another renderer's format");
     convert_cmd->add_option("scene", convert_scene, "Scene file")->required()->check(CLI::ExistingFile);
@@ -487,6 +530,16 @@ int main(int argc, char** argv) {
         ->check(CLI::NonNegativeNumber);
     check_cmd->add_option("-t,--threads", check_options.threads, "Worker threads for Whitted (default: all cores)");
     check_cmd->add_flag("-q,--quiet", check_options.quiet, "Print only the verdict line");
+    check_cmd->add_flag("--terms", check_options.terms,
+                        "Check term by term: the scene with only ambient, only diffuse, only specular, and each "
+                        "light alone (several lights), each against POV-Ray; the last line names the terms "
+                        "that disagree");
+    std::vector<std::string> check_layers;
+    check_cmd
+        ->add_option("--layers", check_layers,
+                     "Render Whitted's image with these render layers (as `render --layers`) and compare its "
+                     "beauty, then the float sum of the colour layers")
+        ->delimiter(',');
     CLI::Option* povray_image_option =
         check_cmd
             ->add_option("--povray-image", check_options.povray_image,
@@ -541,7 +594,8 @@ int main(int argc, char** argv) {
         return code == 0 ? 0 : exit_bad_input;
     }
 
-    if ((*render_cmd || *check_cmd) && !embree_isa_usable()) return exit_bad_input;
+    if ((*render_cmd || *check_cmd || *explain_cmd) && !embree_isa_usable()) return exit_bad_input;
+    if (*explain_cmd) return run_explain(explain_scene, explain_pixel_text, explain_json, explain_threads);
     if (*render_cmd) {
         const int code = run_render(render_args);
         // The image is on disk and the summary printed: skip tearing down the BVH, the image
@@ -558,6 +612,12 @@ int main(int argc, char** argv) {
         rule.required_fraction = compare_fraction;
         rule.max_error = compare_max_error / 65535.0;
         return run_compare_command(compare_first, compare_second, rule, compare_clip);
+    }
+    try {
+        check_options.layers = parse_layers(check_layers);
+    } catch (const std::invalid_argument& e) {
+        print_error(e.what());
+        return exit_bad_input;
     }
     check_options.rule.tolerance = tolerance_codes / 65535.0;
     check_options.rule.max_error = max_error_codes / 65535.0;

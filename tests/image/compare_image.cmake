@@ -12,6 +12,9 @@
 # no channel off by more than 64 codes (docs/validation.md, "The pass rule"). No tolerance of
 # this tier's own. SHA256 (from ref/references.txt) proves the file is the one POV-Ray wrote.
 #
+# With -DLAYERS=<list> Whitted renders with those render layers (`check --layers`), so the
+# beauty compared is the float sum of the colour layers (docs/layers.md).
+#
 # OUT_DIR keeps check's report (ours.png, povray.png, diff.png, metrics.json, report.html).
 
 foreach(var WHITTED SCENE REFERENCE EXPOSURE SHA256 OUT_DIR)
@@ -32,9 +35,13 @@ endif()
 file(REMOVE_RECURSE "${OUT_DIR}")  # an earlier failure's report would mislead
 # WHITTED_POVRAY points nowhere: should anything try to run POV-Ray, the test fails instead of
 # quietly depending on it. This tier runs where POV-Ray is not installed.
+set(layer_arguments)
+if(DEFINED LAYERS AND NOT LAYERS STREQUAL "")
+  set(layer_arguments --layers "${LAYERS}")
+endif()
 execute_process(COMMAND ${CMAKE_COMMAND} -E env WHITTED_POVRAY=/nonexistent/povray
                         "${WHITTED}" check "${SCENE}" --povray-image "${REFERENCE}" --exposure "${EXPOSURE}"
-                        --report "${OUT_DIR}"
+                        --report "${OUT_DIR}" ${layer_arguments}
                 RESULT_VARIABLE check_result)
 if(NOT check_result EQUAL 0)
   message(FATAL_ERROR "whitted check against the stored POV-Ray image failed (exit ${check_result}); "

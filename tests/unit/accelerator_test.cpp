@@ -120,7 +120,7 @@ TEST_P(PacketsPerIsa, EachRayGetsWhatItGetsAloneAndInactiveLanesAreUntouched) {
             }
             SurfaceHit hits[lanes];
             bool found[lanes], blocked[lanes];
-            const SurfaceHit sentinel{-7, {1, 2, 3}, {4, 5, 6}, 99};
+            const SurfaceHit sentinel{-7, {1, 2, 3}, {4, 5, 6}, 99, {7, 8, 9}, 98};
             for (int i = 0; i < lanes; ++i) hits[i] = sentinel, found[i] = true, blocked[i] = true;
             accelerator.intersect_packet(rays, active, count, hits, found);
             accelerator.occluded_packet(shadow_rays, active, count, blocked);

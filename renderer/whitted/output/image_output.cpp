@@ -116,6 +116,10 @@ void check_format_options(const std::string& path, const OutputOptions& options)
     };
     if (options.half) refuse("--half");
     if (!options.exr_compression.empty()) refuse("--exr-compression");
+    if (!options.layers_from.empty())
+        throw std::invalid_argument("render layers (" + options.layers_from + ") cannot apply to '" + path +
+                                    "': they are written as channels of an EXR only; write a .exr, or give "
+                                    "--layers none");
     if (is_jpeg(ext) && options.bit_depth != 0 && options.bit_depth != 8)
         throw std::invalid_argument("--bit-depth " + std::to_string(options.bit_depth) + " cannot apply to '" + path +
                                     "': JPEG files hold 8 bits per channel; write a .png or .tif for 16 bits");
@@ -181,6 +185,28 @@ void write_exr(const Image& image, const std::string& temp_path, bool half, Imf:
     for (int c = 0; c < 3; ++c)
         frame.insert(names[c], Imf::Slice(type, const_cast<char*>(base + c * element), 3 * element,
                                           3 * element * size_t(image.width)));
+    // Render layers: `layer.channel` names as Nuke and Blender read them (docs/layers.md). Data
+    // layers (normals, positions, ids) stay 32-bit float even with --half: half holds integers
+    // exactly only up to 2048.
+    std::vector<std::vector<Imath::half>> layer_halves(image.layers.size());
+    for (size_t l = 0; l < image.layers.size(); ++l) {
+        const ImageLayer& layer = image.layers[l];
+        const size_t channels = layer.channels.size();
+        const Imf::PixelType layer_type = layer.data ? Imf::FLOAT : type;
+        const char* layer_base = reinterpret_cast<const char*>(layer.values.data());
+        size_t layer_element = sizeof(float);
+        if (layer_type == Imf::HALF) {
+            layer_halves[l].assign(layer.values.begin(), layer.values.end());
+            layer_base = reinterpret_cast<const char*>(layer_halves[l].data());
+            layer_element = sizeof(Imath::half);
+        }
+        for (size_t c = 0; c < channels; ++c) {
+            header.channels().insert(layer.channels[c], Imf::Channel(layer_type));
+            frame.insert(layer.channels[c],
+                         Imf::Slice(layer_type, const_cast<char*>(layer_base + c * layer_element),
+                                    channels * layer_element, channels * layer_element * size_t(image.width)));
+        }
+    }
     try {
         Imf::OutputFile file(temp_path.c_str(), header);
         file.setFrameBuffer(frame);

@@ -16,6 +16,9 @@ struct OutputOptions {
     std::string ocio_config;      ///< empty: $OCIO, else the built-in config
     std::string display, view;    ///< empty: the config's defaults
     std::vector<std::pair<std::string, std::string>> metadata;  ///< extra string attributes
+    /// Where render layers were asked for ("--layers", or render.layers' file:line:col); empty
+    /// when none were: layers go to EXR files only.
+    std::string layers_from;
 };
 
 enum class OutputKind { linear_exr, display_referred };
@@ -29,7 +32,7 @@ OutputKind output_kind(const std::string& path);
 void check_output_path(const std::string& path);
 
 /// Checks, before any rendering, that every option given applies to the format `path` names
-/// (EXR: --half, --exr-compression; PNG/JPEG/TIFF: --bit-depth, --ocio-config, --display,
+/// (EXR: --half, --exr-compression, render layers; PNG/JPEG/TIFF: --bit-depth, --ocio-config, --display,
 /// --view; JPEG 8 bits only) and that the config loads and has the display and view. Throws
 /// std::invalid_argument naming the option and what would apply (a bad display or view lists
 /// the config's).

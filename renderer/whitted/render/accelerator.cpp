@@ -588,16 +588,18 @@ struct Accelerator::Impl {
                     hit.v = v;
                     hit.normal = embree_normal;
                 }
-                out.normal = triangle_normal(mesh, prim, hit);
                 out.geometric_normal = normalize(hit.normal);
+                out.normal = mesh.normals.empty() ? out.geometric_normal : triangle_normal(mesh, prim, hit);
                 out.material = mesh.triangle_materials.empty() ? mesh.material : mesh.triangle_materials[prim];
+                out.object = mesh.object;
             } else {
                 // The callback computed this hit in double and kept it.
                 hit.t = best_t;
-                out.normal = normalize(best_normal);
-                out.geometric_normal = out.normal;
-                out.material =
-                    kinds[geom] == ShapeKind::spheres ? scene.spheres[prim].material : scene.boxes[prim].material;
+                out.normal = out.geometric_normal = normalize(best_normal);
+                if (kinds[geom] == ShapeKind::spheres)
+                    out.material = scene.spheres[prim].material, out.object = scene.spheres[prim].object;
+                else
+                    out.material = scene.boxes[prim].material, out.object = scene.boxes[prim].object;
             }
             out.t = hit.t;
             t_max = hit.t;
@@ -608,9 +610,9 @@ struct Accelerator::Impl {
             if (intersect_plane(plane, ray, ray.t_min, t_max, plane_hit)) {
                 t_max = plane_hit.t;
                 out.t = plane_hit.t;
-                out.normal = plane.normal;
-                out.geometric_normal = plane.normal;
+                out.normal = out.geometric_normal = plane.normal;
                 out.material = plane.material;
+                out.object = plane.object;
                 found = true;
             }
         }

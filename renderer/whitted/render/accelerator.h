@@ -42,6 +42,7 @@ struct SurfaceHit {
     /// Which side is lit is still decided with `normal`, as POV-Ray decides it (docs/validation.md,
     /// "Which side is lit").
     Vec3 geometric_normal;
+    uint32_t object = 0;  ///< Scene::objects index + 1 (SceneObject): the objectId layer
 };
 
 /// Ray queries over a Scene. Embree's BVH finds the candidates (triangles natively, spheres and

@@ -71,7 +71,121 @@ void render_block_single_sample(const Scene& scene, const LectureShading& shadin
     }
 }
 
+/// render_block_single_sample with layers: the same packets, watched by a LayerRecorder.
+void render_block_layers_single_sample(const Scene& scene, const LectureShading& shading, LayerSet selection,
+                                       int x_begin, int x_end, int y_begin, int y_end, Image& image,
+                                       RayCounts& counts) {
+    constexpr int side = 4;
+    LayerRecorder recorder(scene, Accelerator::packet_size);
+    PixelLayers pixel;
+    for (int by = y_begin; by < y_end; by += side) {
+        for (int bx = x_begin; bx < x_end; bx += side) {
+            PacketArray<Ray, Accelerator::packet_size> rays;
+            PacketArray<Color, Accelerator::packet_size> radiance;
+            int pixel_x[Accelerator::packet_size], pixel_y[Accelerator::packet_size];
+            int count = 0;
+            for (int y = by; y < std::min(by + side, y_end); ++y) {
+                for (int x = bx; x < std::min(bx + side, x_end); ++x) {
+                    double x0, y0;
+                    sample_position(x, y, 0, 0, 1, scene.width, scene.height, x0, y0);
+                    rays[count] = camera_ray(scene.camera, x0, y0);
+                    pixel_x[count] = x, pixel_y[count] = y;
+                    ++count;
+                }
+            }
+            recorder.reset();
+            shading.trace_packet(rays.data(), count, 0, radiance.data(), counts, recorder);
+            counts.camera += count;
+            for (int k = 0; k < count; ++k) {
+                const size_t index = size_t(pixel_y[k]) * scene.width + pixel_x[k];
+                pixel.clear();
+                pixel.add_sample(recorder.lane(k), true);
+                store_pixel_layers(pixel, selection, image.layers, index, &image.rgb[3 * index]);
+            }
+        }
+    }
+}
+
+/// render_pixel with layers, for n×n samples: the same packets, watched by a LayerRecorder.
+void render_pixel_layers(const Scene& scene, const LectureShading& shading, LayerSet selection, int i, int j,
+                         LayerRecorder& recorder, Image& image, RayCounts& counts) {
+    const int n = scene.samples;
+    PacketArray<Ray, Accelerator::packet_size> rays;
+    PacketArray<Color, Accelerator::packet_size> radiance;
+    PixelLayers pixel;
+    int count = 0;
+    bool first = true;
+    for (int b = 0; b < n; ++b) {
+        for (int a = 0; a < n; ++a) {
+            double x0, y0;
+            sample_position(i, j, a, b, n, scene.width, scene.height, x0, y0);
+            rays[count++] = camera_ray(scene.camera, x0, y0);
+            if (count == Accelerator::packet_size || (a == n - 1 && b == n - 1)) {
+                recorder.reset();
+                shading.trace_packet(rays.data(), count, 0, radiance.data(), counts, recorder);
+                for (int k = 0; k < count; ++k) {
+                    pixel.add_sample(recorder.lane(k), first);
+                    first = false;
+                }
+                counts.camera += count;
+                count = 0;
+            }
+        }
+    }
+    pixel.finish(n * n);
+    const size_t index = size_t(j) * scene.width + i;
+    store_pixel_layers(pixel, selection, image.layers, index, &image.rgb[3 * index]);
+}
+
+/// One tile with layers.
+void render_tile_layers(const Scene& scene, const LectureShading& shading, LayerSet selection, int x_begin, int x_end,
+                        int y_begin, int y_end, Image& image, RayCounts& counts) {
+    if (scene.samples == 1) {
+        render_block_layers_single_sample(scene, shading, selection, x_begin, x_end, y_begin, y_end, image, counts);
+        return;
+    }
+    LayerRecorder recorder(scene, Accelerator::packet_size);
+    for (int y = y_begin; y < y_end; ++y)
+        for (int x = x_begin; x < x_end; ++x)
+            render_pixel_layers(scene, shading, selection, x, y, recorder, image, counts);
+}
+
 }  // namespace
+
+std::vector<CameraPacket> camera_packets(const Scene& scene, int i, int j) {
+    std::vector<CameraPacket> packets;
+    const int n = scene.samples;
+    if (n == 1) {
+        // render_block_single_sample's blocks: 4×4 from each 32×32 tile's corner, so at multiples of 4.
+        constexpr int side = 4;
+        const int bx = i / side * side, by = j / side * side;
+        CameraPacket packet;
+        for (int y = by; y < std::min(by + side, scene.height); ++y) {
+            for (int x = bx; x < std::min(bx + side, scene.width); ++x) {
+                double x0, y0;
+                sample_position(x, y, 0, 0, 1, scene.width, scene.height, x0, y0);
+                packet.rays.push_back(camera_ray(scene.camera, x0, y0));
+                packet.sample.push_back(x == i && y == j ? 0 : -1);
+            }
+        }
+        packets.push_back(std::move(packet));
+        return packets;
+    }
+    CameraPacket packet;
+    for (int b = 0; b < n; ++b) {
+        for (int a = 0; a < n; ++a) {
+            double x0, y0;
+            sample_position(i, j, a, b, n, scene.width, scene.height, x0, y0);
+            packet.rays.push_back(camera_ray(scene.camera, x0, y0));
+            packet.sample.push_back(b * n + a);
+            if (int(packet.rays.size()) == Accelerator::packet_size || (a == n - 1 && b == n - 1)) {
+                packets.push_back(std::move(packet));
+                packet = CameraPacket();
+            }
+        }
+    }
+    return packets;
+}
 
 RenderResult render(const Scene& scene, const Accelerator& accelerator, const RenderOptions& options) {
     using clock = std::chrono::steady_clock;
@@ -84,6 +198,7 @@ RenderResult render(const Scene& scene, const Accelerator& accelerator, const Re
     result.image.width = scene.width;
     result.image.height = scene.height;
     result.image.rgb.assign(size_t(scene.width) * scene.height * 3, 0.0f);
+    result.image.layers = make_image_layers(scene, options.layers);
     std::atomic<size_t> tiles_done{0};
     std::atomic<uint64_t> camera_rays{0}, shadow_rays{0}, reflected_rays{0};
     const LectureShading shading(scene, accelerator);
@@ -114,7 +229,10 @@ RenderResult render(const Scene& scene, const Accelerator& accelerator, const Re
                 const int x_begin = int(t % tiles_x) * tile, y_begin = int(t / tiles_x) * tile;
                 const int x_end = std::min(x_begin + tile, scene.width), y_end = std::min(y_begin + tile, scene.height);
                 RayCounts counts;
-                if (scene.samples == 1) {
+                if (!options.layers.empty()) {
+                    render_tile_layers(scene, shading, options.layers, x_begin, x_end, y_begin, y_end, result.image,
+                                       counts);
+                } else if (scene.samples == 1) {
                     render_block_single_sample(scene, shading, x_begin, x_end, y_begin, y_end, result.image, counts);
                 } else {
                     for (int y = y_begin; y < y_end; ++y) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "whitted/render/accelerator.h"
+#include "whitted/render/layers.h"
 #include "whitted/render/shading.h"
 #include "whitted/scene/scene.h"
 
@@ -14,7 +15,8 @@ namespace whitted {
 /// A linear, scene-referred RGB image, rows from the top.
 struct Image {
     int width = 0, height = 0;
-    std::vector<float> rgb;  ///< 3 floats per pixel
+    std::vector<float> rgb;          ///< 3 floats per pixel: the beauty
+    std::vector<ImageLayer> layers;  ///< render layers, when asked for (docs/layers.md)
     const float* pixel(int x, int y) const { return &rgb[3 * (size_t(y) * width + x)]; }
 };
 
@@ -26,6 +28,9 @@ struct RenderProgress {
 
 struct RenderOptions {
     int threads = 0;  ///< 0 = all cores
+    /// Render layers to compute. With any, the beauty is the float sum of the colour layers
+    /// (docs/layers.md); without, the render takes the path that knows nothing of layers.
+    LayerSet layers;
     /// Set from outside (a signal handler) to stop early; checked before every tile.
     const std::atomic<bool>* cancel = nullptr;
     /// Called from one thread a few times a second while rendering (e.g. a progress bar).
@@ -45,5 +50,15 @@ RenderResult render(const Scene& scene, const Accelerator& accelerator, const Re
 
 /// One pixel, all its samples averaged (box filter).
 Color render_pixel(const Scene& scene, const LectureShading& shading, int i, int j, RayCounts& counts);
+
+/// The camera rays render() traces together in one packet, and which of them are pixel (i, j)'s.
+struct CameraPacket {
+    std::vector<Ray> rays;
+    std::vector<int> sample;  ///< per ray: its sample number b·n + a in pixel (i, j), or −1 (another pixel's)
+};
+/// The packets in which render() traces pixel (i, j)'s camera rays, in order: with one sample per
+/// pixel, the 4×4 block of pixels that holds it; with n×n samples, its samples 16 at a time. So
+/// `whitted explain` traces exactly what the render traced.
+std::vector<CameraPacket> camera_packets(const Scene& scene, int i, int j);
 
 }  // namespace whitted

@@ -51,19 +51,55 @@ double LectureShading::specular_lobe(const Material& material, const Vec3& norma
     return r_dot_l > 0 ? power(r_dot_l, material.p) : 0.0;
 }
 
+namespace {
+/// The observer of a render without layers: every call is empty and inlined away.
+struct NoObserver {
+    static constexpr bool watching = false;
+    void miss(int, int, const Ray&, const Color&, const Color&) {}
+    void hit(int, int, const Ray&, const SurfaceHit&, const Vec3&) {}
+    void ambient(int, int, const Color&) {}
+    void light(int, int, size_t, const LightTerms&) {}
+    void local(int, int, const Color&, const Color&, const Color&) {}
+    void mirror(int, int, const Ray&, const Color&) {}
+};
+/// PathObserver behind the same interface, with `watching` for what only it needs computed.
+struct Watching {
+    static constexpr bool watching = true;
+    PathObserver& to;
+    void miss(int i, int level, const Ray& r, const Color& w, const Color& seen) { to.miss(i, level, r, w, seen); }
+    void hit(int i, int level, const Ray& r, const SurfaceHit& h, const Vec3& n) { to.hit(i, level, r, h, n); }
+    void ambient(int i, int level, const Color& a) { to.ambient(i, level, a); }
+    void light(int i, int level, size_t k, const LightTerms& t) { to.light(i, level, k, t); }
+    void local(int i, int level, const Color& w, const Color& l, const Color& a) { to.local(i, level, w, l, a); }
+    void mirror(int i, int level, const Ray& r, const Color& w) { to.mirror(i, level, r, w); }
+};
+}  // namespace
+
 void LectureShading::direct_lighting(const SurfaceHit* hits, const Ray* rays, const bool* active, int count,
                                      Color* local, Vec3* normal, RayCounts& counts) const {
+    NoObserver none;
+    direct_lighting_with(hits, rays, active, count, local, normal, counts, 0, none);
+}
+
+template <class Observer>
+void LectureShading::direct_lighting_with(const SurfaceHit* hits, const Ray* rays, const bool* active, int count,
+                                          Color* local, Vec3* normal, RayCounts& counts, int level,
+                                          Observer& observer) const {
     for (int i = 0; i < count; ++i) {
         if (!active[i]) continue;
         normal[i] = facing_normal(hits[i], rays[i]);
         local[i] = m_scene.materials[hits[i].material].ka * m_scene.ambient;  // ambient: ka·Ia
+        observer.hit(i, level, rays[i], hits[i], normal[i]);
+        observer.ambient(i, level, local[i]);
     }
-    for (const Light& light : m_scene.lights) {
+    for (size_t light_index = 0; light_index < m_scene.lights.size(); ++light_index) {
+        const Light& light = m_scene.lights[light_index];
         PacketArray<Ray, packet_size> shadow_rays;  // set where `query`
         bool query[packet_size] = {}, blocked[packet_size] = {}, lit[packet_size] = {};
         double n_dot_l[packet_size];
         for (int i = 0; i < count; ++i) {
             if (!active[i]) continue;
+            if constexpr (Observer::watching) shadow_rays[i] = Ray{}, n_dot_l[i] = 0;  // told even where unlit
             const Vec3& point = hits[i].point;
             Vec3 to_light;  // l
             double light_distance;
@@ -77,6 +113,7 @@ void LectureShading::direct_lighting(const SurfaceHit* hits, const Ray* rays, co
                 light_distance = ray_limits::directional_light_distance - dot(point, to_light);
             }
             n_dot_l[i] = dot(normal[i], to_light);
+            if constexpr (Observer::watching) shadow_rays[i].direction = to_light;  // l, also where unlit
             // The gate on both terms: a light behind the surface adds nothing.
             if (!(n_dot_l[i] > ray_limits::cosine_epsilon)) continue;
             lit[i] = true;
@@ -87,6 +124,18 @@ void LectureShading::direct_lighting(const SurfaceHit* hits, const Ray* rays, co
         }
         m_accelerator.occluded_packet(shadow_rays.data(), query, count, blocked);
         for (int i = 0; i < count; ++i) {
+            if constexpr (Observer::watching) {
+                if (active[i] && !(lit[i] && !(query[i] && blocked[i]))) {  // the light adds nothing here
+                    LightTerms terms;
+                    terms.to_light = shadow_rays[i].direction;
+                    terms.n_dot_l = n_dot_l[i];  // l and n·l stay 0 for a point light at x itself
+                    terms.facing = lit[i];
+                    if (lit[i]) terms.shadow_ray = shadow_rays[i];
+                    terms.shadow_tested = query[i];
+                    terms.blocked = query[i] && blocked[i];
+                    observer.light(i, level, light_index, terms);
+                }
+            }
             if (!lit[i] || (query[i] && blocked[i])) continue;  // a blocked light adds neither term
             const Material& material = m_scene.materials[hits[i].material];
             const Vec3& to_light = shadow_rays[i].direction;
@@ -94,12 +143,36 @@ void LectureShading::direct_lighting(const SurfaceHit* hits, const Ray* rays, co
             const Color specular =
                 material.ks * light.intensity * specular_lobe(material, normal[i], -rays[i].direction, to_light);
             local[i] += diffuse + specular;
+            if constexpr (Observer::watching) {
+                LightTerms terms;
+                terms.to_light = to_light;
+                terms.n_dot_l = n_dot_l[i];
+                terms.facing = true;
+                terms.shadow_ray = shadow_rays[i];
+                terms.shadow_tested = query[i];
+                terms.diffuse = diffuse;
+                terms.specular = specular;
+                observer.light(i, level, light_index, terms);
+            }
         }
     }
 }
 
 void LectureShading::trace_packet(const Ray* first_rays, int count, int hits_so_far, Color* radiance,
                                   RayCounts& counts) const {
+    NoObserver none;
+    trace_packet_with(first_rays, count, hits_so_far, radiance, counts, none);
+}
+
+void LectureShading::trace_packet(const Ray* first_rays, int count, int hits_so_far, Color* radiance, RayCounts& counts,
+                                  PathObserver& observer) const {
+    Watching watching{observer};
+    trace_packet_with(first_rays, count, hits_so_far, radiance, counts, watching);
+}
+
+template <class Observer>
+void LectureShading::trace_packet_with(const Ray* first_rays, int count, int hits_so_far, Color* radiance,
+                                       RayCounts& counts, Observer& observer) const {
     PacketArray<Ray, packet_size> rays;
     PacketArray<Color, packet_size> weight;  // product of the mirror coefficients along the path so far
     bool active[packet_size] = {};
@@ -118,7 +191,9 @@ void LectureShading::trace_packet(const Ray* first_rays, int count, int hits_so_
         bool any_hit = false;
         for (int i = 0; i < count; ++i) {
             if (active[i] && !found[i]) {
-                radiance[i] += weight[i] * m_scene.background;  // a miss sees the background
+                const Color seen = weight[i] * m_scene.background;  // a miss sees the background
+                radiance[i] += seen;
+                observer.miss(i, level, rays[i], weight[i], seen);
                 active[i] = false;
             }
             any_hit |= active[i];
@@ -127,10 +202,13 @@ void LectureShading::trace_packet(const Ray* first_rays, int count, int hits_so_
 
         PacketArray<Color, packet_size> local;  // set where `active`
         PacketArray<Vec3, packet_size> normal;
-        direct_lighting(hits.data(), rays.data(), active, count, local.data(), normal.data(), counts);
+        direct_lighting_with(hits.data(), rays.data(), active, count, local.data(), normal.data(), counts, level,
+                             observer);
         for (int i = 0; i < count; ++i) {
             if (!active[i]) continue;
-            radiance[i] += weight[i] * local[i];
+            const Color added = weight[i] * local[i];
+            radiance[i] += added;
+            observer.local(i, level, weight[i], local[i], added);
             const Material& material = m_scene.materials[hits[i].material];
             if (is_zero(material.km) || level + 1 >= m_scene.max_depth) {
                 active[i] = false;
@@ -141,6 +219,7 @@ void LectureShading::trace_packet(const Ray* first_rays, int count, int hits_so_
             const Vec3 mirror_direction = normalize(normal[i] * (2.0 * dot(normal[i], to_eye)) - to_eye);
             rays[i] = {hits[i].point, mirror_direction, ray_limits::surface_t_min, ray_limits::max_distance};
             weight[i] = weight[i] * material.km;
+            observer.mirror(i, level, rays[i], weight[i]);
             ++counts.reflected;
         }
     }

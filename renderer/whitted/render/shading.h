@@ -21,6 +21,38 @@ struct RayCounts {
     }
 };
 
+/// One light's terms at one surface hit, as LectureShading::direct_lighting computed them.
+struct LightTerms {
+    Vec3 to_light;               ///< l (unit)
+    double n_dot_l = 0;          ///< with the ray-facing n
+    bool facing = false;         ///< n·l > cosine_epsilon: the light is in front of the surface
+    Ray shadow_ray;              ///< from x toward the light; set where `facing`
+    bool shadow_tested = false;  ///< the shadow ray's range was not empty (else the light is on the surface)
+    bool blocked = false;        ///< something lies on the shadow ray
+    Color diffuse, specular;     ///< kd·I·(n·l) and ks·I·lobe; zero unless facing and not blocked
+};
+
+/// Watches LectureShading evaluate the equation, lane by lane and path segment by segment
+/// (`level` 0 is the camera ray): the render layers (docs/layers.md) and `whitted explain` are
+/// built from what it is told, so they see exactly the numbers that made the pixel. A render
+/// without layers traces with no observer at all, through the same code.
+class PathObserver {
+public:
+    virtual ~PathObserver() = default;
+    /// The segment missed everything: `seen` = weight·background was added to the radiance.
+    virtual void miss(int lane, int level, const Ray& ray, const Color& weight, const Color& seen) = 0;
+    /// The segment hit; `normal` is the shading normal turned toward the ray.
+    virtual void hit(int lane, int level, const Ray& ray, const SurfaceHit& hit, const Vec3& normal) = 0;
+    /// ka·Ia at the hit.
+    virtual void ambient(int lane, int level, const Color& ambient) = 0;
+    /// Light number `light` (0-based, file order) at the hit.
+    virtual void light(int lane, int level, size_t light, const LightTerms& terms) = 0;
+    /// local = ka·Ia + Σ(diffuse + specular) at the hit; `added` = weight·local went into the radiance.
+    virtual void local(int lane, int level, const Color& weight, const Color& local, const Color& added) = 0;
+    /// The mirror ray r leaves the hit; `weight` is the path's new weight (times km).
+    virtual void mirror(int lane, int level, const Ray& mirror_ray, const Color& weight) = 0;
+};
+
 /// The lecture's shading model, evaluated Whitted-style:
 ///
 ///   L = ka·Ia + Σ_i [ kd·I_i·max(0, n·l_i) + ks·I_i·max(0, n·h_i)^p ] + km·L(r)
@@ -43,6 +75,9 @@ public:
     /// Radiance along `count` (≤ Accelerator::packet_size) rays that start their paths here,
     /// each as trace(rays[i], hits_so_far) would give it.
     void trace_packet(const Ray* rays, int count, int hits_so_far, Color* radiance, RayCounts& counts) const;
+    /// The same, bit for bit, telling `observer` every term as it is computed.
+    void trace_packet(const Ray* rays, int count, int hits_so_far, Color* radiance, RayCounts& counts,
+                      PathObserver& observer) const;
 
     /// ka·Ia plus the unshadowed lights' diffuse and specular terms at one hit, for up to a
     /// packet of hits (`active` marks the lanes in use). `normal` receives each hit's
@@ -60,6 +95,15 @@ public:
     }
 
 private:
+    /// trace_packet and direct_lighting, with `Observer` either PathObserver or NoObserver, whose
+    /// calls compile to nothing: a render without layers pays nothing for them.
+    template <class Observer>
+    void trace_packet_with(const Ray* rays, int count, int hits_so_far, Color* radiance, RayCounts& counts,
+                           Observer& observer) const;
+    template <class Observer>
+    void direct_lighting_with(const SurfaceHit* hits, const Ray* rays, const bool* active, int count, Color* local,
+                              Vec3* normal, RayCounts& counts, int level, Observer& observer) const;
+
     const Scene& m_scene;
     const Accelerator& m_accelerator;
 };

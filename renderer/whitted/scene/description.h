@@ -125,6 +125,8 @@ struct SceneDescription {
     CameraDescription camera;
     ImageDescription image;
     Located<int64_t> max_depth{5};
+    /// render.layers: the EXR render layers asked for, as written (docs/layers.md).
+    std::vector<Located<std::string>> layers;
     Located<Color> ambient{Color{1.0}};
     std::vector<LightDescription> lights;
     std::vector<MaterialDescription> materials;  ///< in file order

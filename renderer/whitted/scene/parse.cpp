@@ -493,6 +493,19 @@ ObjectDescription parse_object(ParseContext& ctx, const YAML::Node& node, const 
     return object;
 }
 
+/// render.layers: a list of layer names (checked against the known layers in validation).
+std::vector<Located<std::string>> parse_render_layers(ParseContext& ctx, const YAML::Node& node) {
+    if (!node.IsSequence()) ctx.fail(node, "render.layers: expected a list of layer names, got " + describe(node));
+    std::vector<Located<std::string>> layers;
+    for (size_t i = 0; i < node.size(); ++i) {
+        Located<std::string> layer(parse_string(ctx, node[i], "render.layers[" + std::to_string(i) + "]"));
+        layer.where = ctx.at(node[i]);
+        layer.given = true;
+        layers.push_back(std::move(layer));
+    }
+    return layers;
+}
+
 SceneDescription parse_document(ParseContext& ctx, const YAML::Node& root) {
     if (!root || root.IsNull())
         throw InputError({ctx.file, 1, 1}, "the scene is empty: expected a map with 'camera', 'image' and 'objects'");
@@ -509,8 +522,9 @@ SceneDescription parse_document(ParseContext& ctx, const YAML::Node& root) {
     scene.camera = parse_camera(ctx, map.require("camera"));
     scene.image = parse_image(ctx, map.require("image"));
     if (map.has("render")) {
-        MapReader render(ctx, map.get("render"), "render", {"max_depth"});
+        MapReader render(ctx, map.get("render"), "render", {"max_depth", "layers"});
         render.integer(scene.max_depth, "max_depth");
+        if (render.has("layers")) scene.layers = parse_render_layers(ctx, render.get("layers"));
     } else {
         scene.max_depth.where = map.where();
     }

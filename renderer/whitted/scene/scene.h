@@ -45,18 +45,21 @@ struct Sphere {
     Vec3 center;
     double radius = 1;
     uint32_t material = 0;
+    uint32_t object = 0;  ///< Scene::objects index + 1
 };
 
 struct Box {
     Transform object_to_world;
     Vec3 min, max;
     uint32_t material = 0;
+    uint32_t object = 0;  ///< Scene::objects index + 1
 };
 
 struct Plane {
     Vec3 point;
     Vec3 normal;  ///< unit
     uint32_t material = 0;
+    uint32_t object = 0;  ///< Scene::objects index + 1
 };
 
 /// Triangles in world space, stored as Embree wants them (float, xyz + padding). Positions
@@ -67,8 +70,17 @@ struct TriangleMesh {
     std::vector<float> normals;                ///< empty, or 3 floats per vertex: smooth shading
     std::vector<uint32_t> triangle_materials;  ///< empty when every triangle uses `material`
     uint32_t material = 0;
+    uint32_t object = 0;  ///< Scene::objects index + 1 (one object per mesh or triangle)
     size_t triangle_count() const { return indices.size() / 3; }
     size_t vertex_count() const { return positions.size() / 4; }
+};
+
+/// A shape as the scene file wrote it: sphere, plane, box, triangle or mesh (groups are not
+/// objects; their members are). Numbered 1, 2, ... in file order, depth first through groups:
+/// the `objectId` layer and `whitted explain` use these numbers (0 = nothing hit).
+struct SceneObject {
+    ObjectType type = ObjectType::sphere;
+    SourceLocation where;
 };
 
 struct Scene {
@@ -80,7 +92,10 @@ struct Scene {
     Color ambient;  ///< I_a
     Camera camera;
     std::vector<Light> lights;
-    std::vector<Material> materials;
+    std::vector<Material> materials;          ///< named ones in file order, then inline and MTL ones as met
+    std::vector<std::string> material_names;  ///< per material: as in `materials` or the MTL; "" inline
+    std::vector<SceneObject> objects;
+    std::vector<std::string> layers;  ///< render.layers: the EXR layers asked for (docs/layers.md)
     std::vector<Sphere> spheres;
     std::vector<Box> boxes;
     std::vector<Plane> planes;

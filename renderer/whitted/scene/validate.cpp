@@ -2,6 +2,7 @@
 // SceneDescription → Scene: range checks that need whole values (or several of them), material
 // names resolved, transforms folded, meshes loaded. Every refusal names file:line:col.
 
+#include "whitted/render/layers.h"
 #include "whitted/scene/mesh_file.h"
 #include "whitted/scene/scene.h"
 #include "whitted/scene/text_checks.h"
@@ -40,6 +41,7 @@ public:
         for (const auto& material : description.materials) {
             m_material_index[material.name] = static_cast<uint32_t>(scene.materials.size());
             scene.materials.push_back(make_material(material, "materials." + material.name));
+            scene.material_names.push_back(material.name);
             m_material_names.push_back(material.name);
         }
     }
@@ -55,6 +57,7 @@ private:
         const MaterialReference& reference = *object.material;
         if (reference.inline_) {
             m_scene.materials.push_back(make_material(*reference.inline_, kind + ".material"));
+            m_scene.material_names.push_back("");
             return static_cast<uint32_t>(m_scene.materials.size() - 1);
         }
         const auto it = m_material_index.find(reference.name);
@@ -78,13 +81,14 @@ private:
             case ObjectType::sphere: {
                 if (!(object.radius.value > 0)) fail(object.radius.where, "sphere.radius must be > 0");
                 m_scene.spheres.push_back(
-                    {to_world, object.center.value, object.radius.value, resolve_material(object)});
+                    {to_world, object.center.value, object.radius.value, resolve_material(object), add_id(object)});
                 break;
             }
             case ObjectType::plane: {
                 require_non_zero(object.normal, "plane.normal");
                 const Vec3 normal = normalize(to_world.apply_normal(object.normal.value));
-                m_scene.planes.push_back({to_world.apply_point(object.point.value), normal, resolve_material(object)});
+                m_scene.planes.push_back(
+                    {to_world.apply_point(object.point.value), normal, resolve_material(object), add_id(object)});
                 break;
             }
             case ObjectType::box: {
@@ -92,7 +96,7 @@ private:
                 if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z))
                     fail(object.max.where, "box: min must be less than max on every axis (min " + format(lo) +
                                                ", max " + format(hi) + ")");
-                m_scene.boxes.push_back({to_world, lo, hi, resolve_material(object)});
+                m_scene.boxes.push_back({to_world, lo, hi, resolve_material(object), add_id(object)});
                 break;
             }
             case ObjectType::triangle: {
@@ -100,6 +104,7 @@ private:
                 mesh.material = resolve_material(object);
                 for (const Vec3& v : object.vertices) push_position(mesh, to_world.apply_point(v));
                 mesh.indices = {0, 1, 2};
+                mesh.object = add_id(object);
                 add_mesh(std::move(mesh), object.vertices_where);
                 break;
             }
@@ -139,6 +144,7 @@ private:
                 fail(object.normals_where, "mesh.normals[" + std::to_string(i) + "] must not be the zero vector");
             push_normal(mesh, to_world.apply_normal(object.normals[i]));
         }
+        mesh.object = add_id(object);
         add_mesh(std::move(mesh), object.vertices_where);
     }
 
@@ -165,6 +171,7 @@ private:
                 try {
                     m_scene.materials.push_back(make_material(
                         data.materials[i], object.file_path + ": material '" + data.materials[i].name + "'"));
+                    m_scene.material_names.push_back(data.materials[i].name);
                 } catch (const InputError& e) {
                     throw with_reference(e);
                 }
@@ -189,6 +196,7 @@ private:
                                       {data.normals[3 * i], data.normals[3 * i + 1], data.normals[3 * i + 2]}));
         }
         mesh.indices = std::move(data.indices);
+        mesh.object = add_id(object);
         add_mesh(std::move(mesh), object.file.where);
     }
 
@@ -200,6 +208,12 @@ private:
                 fail(where, "vertex " + std::to_string(i / 4) +
                                 " is beyond float range (about 3.4e38) once transformed to world space");
         m_scene.meshes.push_back(std::move(mesh));
+    }
+
+    /// The object's number (1-based, file order): see SceneObject.
+    uint32_t add_id(const ObjectDescription& object) {
+        m_scene.objects.push_back({object.type, object.where});
+        return static_cast<uint32_t>(m_scene.objects.size());
     }
 
     static void push_position(TriangleMesh& mesh, const Vec3& p) {
@@ -330,6 +344,14 @@ Scene validate_scene(const SceneDescription& d) {
     if (d.max_depth.value < 1 || d.max_depth.value > limits::max_depth)
         fail(d.max_depth.where, "render.max_depth must be between 1 and " + std::to_string(limits::max_depth));
     require_non_negative(d.ambient, "ambient");
+    for (const Located<std::string>& layer : d.layers) {
+        try {
+            parse_layers({layer.value});
+        } catch (const std::invalid_argument& e) {
+            fail(layer.where, std::string("render.layers: ") + e.what());
+        }
+        scene.layers.push_back(layer.value);
+    }
     scene.width = static_cast<int>(image.width.value);
     scene.height = static_cast<int>(image.height.value);
     scene.samples = static_cast<int>(image.samples.value);

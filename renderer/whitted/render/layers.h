@@ -1,0 +1,116 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// Render layers (AOVs): the pixel's radiance split into the lecture's terms, and data about the
+// camera ray's first hit, written as extra channels of the EXR (docs/layers.md).
+
+#include "whitted/core/vec3.h"
+#include "whitted/render/shading.h"
+#include "whitted/scene/scene.h"
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace whitted {
+
+/// The layers one can ask for, by their names in --layers and render.layers. `lights` stands for
+/// one layer per light, light1, light2, ... (1-based, file order).
+enum class Layer : uint32_t {
+    ambient,     ///< ka·Ia at the first hit
+    diffuse,     ///< Σ_i kd·I_i·max(0, n·l_i) at the first hit, over the unshadowed lights
+    specular,    ///< Σ_i ks·I_i·max(0, n·h_i)^p at the first hit
+    mirror,      ///< km·L(r): everything the first hit's mirror ray brings back, weighted
+    background,  ///< the background colour where the camera ray misses
+    lights,      ///< light<k>: light k's diffuse + specular at the first hit
+    N,           ///< shading normal at the first hit, turned toward the camera ray
+    Ng,          ///< geometric normal at the first hit, not turned
+    P,           ///< world-space first hit point
+    Z,           ///< camera ray distance t to the first hit; +inf on a miss
+    albedo,      ///< kd of the first hit's material
+    objectId,    ///< SceneObject number (1-based, file order) of the first hit; 0 on a miss
+    materialId,  ///< Scene::materials index + 1 of the first hit's material; 0 on a miss
+    hits,        ///< surface hits along the path (0 = the camera ray missed)
+};
+inline constexpr int layer_kinds = 14;
+
+const char* layer_name(Layer layer);
+std::optional<Layer> find_layer(const std::string& name);
+/// "ambient, diffuse, ..." for messages and --help.
+std::string layer_choices();
+
+/// A set of layers.
+struct LayerSet {
+    uint32_t bits = 0;
+    bool has(Layer layer) const { return bits & (1u << uint32_t(layer)); }
+    void add(Layer layer) { bits |= 1u << uint32_t(layer); }
+    bool empty() const { return bits == 0; }
+    static LayerSet all() { return {(1u << layer_kinds) - 1}; }
+};
+
+/// "all", "none", or names separated by commas (and/or given as several list entries). Throws
+/// std::invalid_argument naming a name that is none of the layers and listing them.
+LayerSet parse_layers(const std::vector<std::string>& names);
+
+/// The radiance of one camera ray split into the layers' terms, and its first hit's data.
+struct PathLayers {
+    Color ambient, diffuse, specular, mirror, background;
+    std::vector<Color> lights;  ///< one per light
+    Vec3 N, Ng, P;
+    double Z = 0;
+    Color albedo;
+    uint32_t object = 0, material = 0;
+    int hits = 0;
+};
+
+/// A PathObserver that sorts every term of a packet's paths into PathLayers, lane by lane.
+class LayerRecorder final : public PathObserver {
+public:
+    LayerRecorder(const Scene& scene, int lanes);
+    /// Starts a new packet: every lane's layers back to a miss with nothing added.
+    void reset();
+    const PathLayers& lane(int i) const { return m_lanes[i]; }
+
+    void miss(int lane, int level, const Ray& ray, const Color& weight, const Color& seen) override;
+    void hit(int lane, int level, const Ray& ray, const SurfaceHit& hit, const Vec3& normal) override;
+    void ambient(int lane, int level, const Color& ambient) override;
+    void light(int lane, int level, size_t light, const LightTerms& terms) override;
+    void local(int lane, int level, const Color& weight, const Color& local, const Color& added) override;
+    void mirror(int, int, const Ray&, const Color&) override {}
+
+private:
+    const Scene& m_scene;
+    std::vector<PathLayers> m_lanes;
+};
+
+/// One layer of an image: `channels` floats per pixel, named as EXR readers expect
+/// (`diffuse.R`, `N.X`, `Z`, ...).
+struct ImageLayer {
+    std::string name;
+    std::vector<std::string> channels;  ///< full EXR channel names
+    bool data = false;                  ///< a data layer (normals, ids, ...): always 32-bit float
+    std::vector<float> values;          ///< channels.size() per pixel, rows from the top
+};
+
+/// The image layers of `selection` for `scene`, sized and zeroed (Z: +inf), in a fixed order.
+std::vector<ImageLayer> make_image_layers(const Scene& scene, LayerSet selection);
+
+/// Layer values of one pixel, in double, before they are stored as float.
+struct PixelLayers {
+    PathLayers sum;    ///< colour terms: summed over the pixel's samples, then averaged by finish()
+    PathLayers first;  ///< data terms: the pixel's first sample's
+    /// Back to no samples, keeping the storage (a render calls this once per pixel).
+    void clear();
+    void add_sample(const PathLayers& sample, bool first_sample);
+    void finish(int samples_per_pixel);
+};
+
+/// Stores pixel `index`'s layers into `layers` (made by make_image_layers with `selection`) and
+/// its beauty into beauty[0..2]: the float sum ambient + diffuse + specular + mirror + background
+/// of the layers' float values, in that order, so that the file's layers add up to its R, G, B
+/// bit for bit.
+void store_pixel_layers(const PixelLayers& pixel, LayerSet selection, std::vector<ImageLayer>& layers, size_t index,
+                        float* beauty);
+
+}  // namespace whitted
