@@ -68,7 +68,7 @@ std::string transform_steps(const std::vector<TransformStep>& steps) {
                 break;
             case TransformStep::Kind::matrix: {
                 out += "{ matrix: [";
-                for (size_t k = 0; k < 16; ++k) out += (k ? ", " : "") + number(s.matrix[k]);
+                for (size_t k = 0; k < 16; ++k) out.append(k ? ", " : "").append(number(s.matrix[k]));
                 out += "] }";
                 break;
             }
@@ -119,17 +119,19 @@ public:
                         break;
                     }
                     out += in + "vertices: [";
-                    for (size_t i = 0; i < o.vertices.size(); ++i) out += (i ? ", " : "") + vec3(o.vertices[i]);
+                    for (size_t i = 0; i < o.vertices.size(); ++i)
+                        out.append(i ? ", " : "").append(vec3(o.vertices[i]));
                     out += "]\n";
                     if (o.type == ObjectType::triangle) break;
                     out += in + "triangles: [";
                     for (size_t i = 0; i < o.triangles.size(); ++i)
-                        out += std::string(i ? ", " : "") + "[" + integer(o.triangles[i][0]) + ", " +
-                               integer(o.triangles[i][1]) + ", " + integer(o.triangles[i][2]) + "]";
+                        out.append(i ? ", [" : "[") += integer(o.triangles[i][0]) + ", " + integer(o.triangles[i][1]) +
+                                                       ", " + integer(o.triangles[i][2]) + "]";
                     out += "]\n";
                     if (!o.normals.empty()) {
                         out += in + "normals: [";
-                        for (size_t i = 0; i < o.normals.size(); ++i) out += (i ? ", " : "") + vec3(o.normals[i]);
+                        for (size_t i = 0; i < o.normals.size(); ++i)
+                            out.append(i ? ", " : "").append(vec3(o.normals[i]));
                         out += "]\n";
                     }
                     break;

@@ -195,17 +195,18 @@ def closed(whitted, scenes_dir, scene, work):
 
 
 def same(whitted, scenes_dir, scene, work):
-    xml = os.path.join(scenes_dir, scene + ".xml")
-    yaml_path = os.path.join(work, scene + ".yaml")
+    xml = os.path.join(scenes_dir, scene + (".yaml" if os.path.exists(os.path.join(scenes_dir, scene + ".yaml"))
+                                            else ".xml"))
+    yaml_path = os.path.join(work, scene + "-converted.yaml")
     run([whitted, "convert", xml, yaml_path])
     a = render_floats(whitted, xml, work, scene)
     b = render_floats(whitted, yaml_path, work, scene + "-yaml")
     if a != b:
-        sys.exit(f"FAIL {scene}: render({scene}.xml) and render(convert -> {scene}.yaml) differ")
+        sys.exit(f"FAIL {scene}: render({os.path.basename(xml)}) and render(convert -> {scene}.yaml) differ")
     lit = sum(any(c > 0 for c in px) for row in a[2] for px in row)
     if lit == 0:
         sys.exit(f"FAIL {scene}: the image is black; the comparison proves nothing")
-    print(f"{scene}: the XML and its YAML conversion render the same {a[0]}x{a[1]} floats ({lit} pixels lit)")
+    print(f"{scene}: the scene and its YAML conversion render the same {a[0]}x{a[1]} floats ({lit} pixels lit)")
     return 0
 
 
