@@ -17,6 +17,9 @@ find_package(PNG REQUIRED)
 find_package(JPEG REQUIRED)
 find_package(TIFF REQUIRED)
 find_package(ZLIB REQUIRED)
+# The Cornell CS4620 course's XML scenes (renderer/whitted/scene/course_xml.cpp): expat reports
+# the line and column of every element, which the error messages need.
+find_package(EXPAT REQUIRED)
 
 # Quirk A: Debian built OpenImageIO with OpenCV, and its exported target names
 # /usr/include/opencv4, which does not exist unless libopencv-dev (+417 MB) is installed.

@@ -12,6 +12,7 @@
 #include "whitted/core/ray.h"
 #include "whitted/output/atomic_files.h"
 #include "whitted/scene/mesh_file.h"
+#include "whitted/scene/msh_file.h"
 #include "whitted/scene/scene.h"
 
 #include <fmt/format.h>
@@ -170,7 +171,9 @@ private:
     }
 
     void mesh_file(const ObjectDescription& object, const Transform& to_world) {
-        const MeshData data = load_obj_mesh(object.file_path, object.file.where);
+        const bool msh = std::filesystem::path(object.file_path).extension() == ".msh";
+        const MeshData data = msh ? load_msh_mesh(object.file_path, object.file.where)
+                                  : load_obj_mesh(object.file_path, object.file.where);
         std::vector<Vec3> vertices, normals;
         for (size_t i = 0; i < data.positions.size() / 3; ++i)
             vertices.push_back({data.positions[3 * i], data.positions[3 * i + 1], data.positions[3 * i + 2]});
@@ -300,7 +303,43 @@ std::string scene_to_sdl(const SceneDescription& d, const ConvertOptions& option
     }
 }
 
+/// What POV-Ray 3.7 cannot render the same way, refused at the place it is written (the
+/// Cornell course's conventions, docs/course-format.md): POV-Ray always turns normals toward the
+/// ray and has no shadow-ray span, path-weight cut-off, window camera or (1 − F)-weighted
+/// substrate that have been checked against it.
+static void refuse_inexpressible(const SceneDescription& d) {
+    const auto refuse = [](const SourceLocation& where, const std::string& what) {
+        throw InputError(where, "cannot convert to POV-Ray: " + what);
+    };
+    if (d.convention.value != Convention::pov)
+        refuse(d.convention.where,
+               "render.convention: course (normals as given, not turned toward the viewer, and "
+               "the course's shadow rays) has no POV-Ray equivalent");
+    if (d.min_weight.value != 0)
+        refuse(d.min_weight.where, "render.min_weight (a path-weight cut-off) has no exact POV-Ray equivalent");
+    const CameraDescription& c = d.camera;
+    if (c.view_height.given && c.type.value == CameraType::perspective)
+        refuse(c.view_height.where,
+               "camera.view_height (a window camera, possibly oblique) is not supported by the "
+               "POV-Ray converter");
+    std::function<void(const MaterialDescription&)> material = [&](const MaterialDescription& m) {
+        if (m.fresnel_ior.given)
+            refuse(m.fresnel_ior.where,
+                   "fresnel_ior (Schlick-weighted mirror over a (1 - F)-weighted substrate) has "
+                   "no POV-Ray equivalent checked against Whitted");
+    };
+    for (const auto& m : d.materials) material(m);
+    std::function<void(const std::vector<ObjectDescription>&)> objects = [&](const auto& list) {
+        for (const auto& object : list) {
+            if (object.material && object.material->inline_) material(*object.material->inline_);
+            objects(object.children);
+        }
+    };
+    objects(d.objects);
+}
+
 static std::string write_sdl(const SceneDescription& d, const ConvertOptions& options) {
+    refuse_inexpressible(d);
     const double exposure = options.exposure;
     const double aspect = double(d.image.width.value) / double(d.image.height.value);
     std::string o;
@@ -320,8 +359,8 @@ static std::string write_sdl(const SceneDescription& d, const ConvertOptions& op
     } else {
         // Explicit right/up and no angle: their lengths are the view's extent in world units.
         o += "camera {\n  orthographic\n  location " + vec(c.eye.value) + "\n  right <" + num(-c.view_width.value) +
-             ", 0, 0>\n  up <0, " + num(c.view_width.value / aspect) + ", 0>\n  sky " + vec(c.up.value) +
-             "\n  look_at " + vec(c.look_at.value) + "\n}\n";
+             ", 0, 0>\n  up <0, " + num(c.view_height.given ? c.view_height.value : c.view_width.value / aspect) +
+             ", 0>\n  sky " + vec(c.up.value) + "\n  look_at " + vec(c.look_at.value) + "\n}\n";
     }
 
     // Lights and objects go inside one light_group, whose lights light only its objects (here:

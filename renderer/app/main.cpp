@@ -5,6 +5,7 @@
 
 #include "converters/pov_writer.h"
 #include "explain_command.h"
+#include "converters/yaml_writer.h"
 #include "reference/check.h"
 #include "whitted/output/atomic_files.h"
 #include "whitted/output/color_management.h"
@@ -217,6 +218,13 @@ int run_render(const RenderArguments& args) {
         for (const std::string& mesh : meshes) refuse_output_over(args.output, mesh, "mesh file");
         scene = validate_scene(description);
         validate_seconds = timer.lap();
+        // The colour layers split each hit's terms at weight 1; a glazed (fresnel_ior) material
+        // scales them by 1 − F, which the layers do not yet follow, so they would not add up.
+        if (!layers.empty())
+            for (const Material& material : scene.materials)
+                if (material.fresnel_r0 >= 0)
+                    throw std::invalid_argument(
+                        "render layers are not available for scenes with a fresnel_ior (glazed) material yet");
     } catch (const InputError& e) {
         print_error(e.what());
         return exit_bad_input;
@@ -304,15 +312,45 @@ int run_render(const RenderArguments& args) {
     }
 }
 
+/// `whitted convert SCENE out.yaml`: any scene Whitted reads (a course .xml file, say) in
+/// Whitted's own format, every value written out.
+int run_convert_to_yaml(const std::string& scene_path, const std::string& output) {
+    try {
+        const std::filesystem::path target(output);
+        const std::filesystem::path dir = target.parent_path().empty() ? "." : target.parent_path();
+        std::error_code error;
+        if (!std::filesystem::is_directory(dir, error))
+            throw std::invalid_argument("cannot write '" + output + "': directory '" + dir.string() +
+                                        "' does not exist");
+        if (std::filesystem::is_directory(target, error))
+            throw std::invalid_argument("cannot write '" + output + "': it is a directory");
+        const SceneDescription description = parse_scene_file(scene_path);
+        validate_scene(description);  // refuse what Whitted itself would refuse
+        yaml::write_yaml_file(description, output);
+        std::fprintf(stderr, "whitted: wrote %s\n", output.c_str());
+        return exit_ok;
+    } catch (const InputError& e) {
+        print_error(e.what());
+        return exit_bad_input;
+    } catch (const std::invalid_argument& e) {
+        print_error(e.what());
+        return exit_bad_input;
+    } catch (const std::exception& e) {
+        print_error(e.what());
+        return exit_failure;
+    }
+}
+
 int run_convert(const std::string& scene_path, const std::string& output) {
     // SIGINT/SIGTERM end the program at once (130/143): the files are written unnamed and only
     // named when complete (write_files_atomically), so there is nothing to clean up.
     install_signal_handlers();
     try {
         const std::string ext = std::filesystem::path(output).extension().string();
+        if (ext == ".yaml" || ext == ".yml") return run_convert_to_yaml(scene_path, output);
         if (ext != ".pov")
             throw std::invalid_argument("cannot convert to '" + output + "': unknown format '" + ext +
-                                        "'; supported: .pov (POV-Ray 3.7)");
+                                        "'; supported: .pov (POV-Ray 3.7), .yaml/.yml (Whitted's own format)");
         // Usage errors before any work: where the two files cannot go. (write_pov_files refuses a
         // directory in the way too, before it replaces anything, for one that appears meanwhile.)
         std::filesystem::path ini_path(output);
@@ -443,10 +481,13 @@ int main(int argc, char** argv) {
         "Environment: OCIO (colour config), WHITTED_POVRAY (POV-Ray for check),\n"
         "WHITTED_EMBREE_ISA=sse2|sse4.2|avx|avx2|avx512 (force Embree's instruction set; the\n"
         "image is the same bit for bit, only the speed differs; --version lists this CPU's).\n"
-        "Scene format: docs/scene-format.md. Examples: examples/lecture/.");
+        "Scene format: docs/scene-format.md. Examples: examples/lecture/.\n"
+        "Cornell CS4620 course scenes (.xml, with .msh meshes) render and convert directly, with the\n"
+        "course's conventions: docs/course-format.md (its images: --display 'Gamma 2.2').");
 
     RenderArguments render_args;
-    CLI::App* render_cmd = app.add_subcommand("render", "Render a scene file (YAML or JSON, format v1) to an image");
+    CLI::App* render_cmd = app.add_subcommand(
+        "render", "Render a scene file (YAML or JSON, format v1; or a course .xml scene) to an image");
     render_cmd->add_option("scene", render_args.scene, "Scene file")->required()->check(CLI::ExistingFile);
     render_cmd
         ->add_option("-o,--output", render_args.output,
@@ -504,7 +545,8 @@ int main(int argc, char** argv) {
     convert_cmd->add_option("scene", convert_scene, "Scene file")->required()->check(CLI::ExistingFile);
     convert_cmd
         ->add_option("output", convert_output,
-                     "Output file; the extension picks the format: .pov = POV-Ray 3.7 (+ a matching .ini)")
+                     "Output file; the extension picks the format: .pov = POV-Ray 3.7 (+ a matching .ini), "
+                     ".yaml/.yml = Whitted's own format (e.g. from a course .xml scene)")
         ->required();
 
     std::string check_scene;

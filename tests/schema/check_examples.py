@@ -117,9 +117,11 @@ def explain(error):
 
 
 def whitted_status(whitted, path, scratch):
-    """`whitted convert` parses and validates the scene without rendering it: 0 = accepted."""
+    """`whitted convert` parses and validates the scene without rendering it: 0 = accepted. To
+    Whitted's own YAML, so that what only the POV-Ray converter refuses (the course's conventions)
+    does not count against the scene."""
     try:
-        result = subprocess.run([whitted, "convert", str(path), str(Path(scratch) / "scene.pov")],
+        result = subprocess.run([whitted, "convert", str(path), str(Path(scratch) / "scene.yaml")],
                                 capture_output=True, text=True, timeout=120)
     except (OSError, subprocess.SubprocessError) as e:
         return None, f"cannot run {whitted}: {e}"

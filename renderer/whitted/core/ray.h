@@ -31,6 +31,10 @@ inline constexpr double max_distance = 1e7;
 inline constexpr double directional_light_distance = 1e6;
 /// The n·l gate: a light counts only where n·l exceeds this (POV-Ray's EPSILON).
 inline constexpr double cosine_epsilon = 1e-10;
+/// `render.convention: course` (the Cornell CS4620 ray tracer): a shadow ray goes along the
+/// unnormalised vector to the light, d = light − x, and counts blockers for t in (1e-6, 1) of
+/// it, i.e. for course_shadow_fraction·|d| < t < |d| along the unit direction.
+inline constexpr double course_shadow_fraction = 1e-6;
 }  // namespace ray_limits
 
 }  // namespace whitted

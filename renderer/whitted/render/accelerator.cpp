@@ -543,14 +543,17 @@ struct Accelerator::Impl {
 
     /// The shading normal at a triangle hit: the face normal, or for smooth meshes the unit
     /// vertex normals blended by barycentric weight and renormalised, as POV-Ray's mesh2 does
-    /// (it falls back to the face normal when the three vertex normals are equal).
+    /// (it falls back to the face normal when the three vertex normals are equal, except under
+    /// render.convention: course).
     Vec3 triangle_normal(const TriangleMesh& mesh, uint32_t prim, const ShapeHit& hit) const {
         if (mesh.normals.empty()) return normalize(hit.normal);
         const uint32_t* index = &mesh.indices[3 * size_t(prim)];
         const Vec3 n0 = vertex_normal(mesh, index[0]), n1 = vertex_normal(mesh, index[1]),
                    n2 = vertex_normal(mesh, index[2]);
         const Vec3 d1 = n0 - n1, d2 = n0 - n2;
-        if (dot(d1, d1) <= 1e-10 && dot(d2, d2) <= 1e-10) return normalize(hit.normal);
+        // The course's convention interpolates always, as its ray tracer does.
+        if (dot(d1, d1) <= 1e-10 && dot(d2, d2) <= 1e-10 && scene.convention != Convention::course)
+            return normalize(hit.normal);
         const Vec3 blended = n0 * (1.0 - hit.u - hit.v) + n1 * hit.u + n2 * hit.v;
         const double len = length(blended);
         return len > 0 ? blended / len : normalize(hit.normal);

@@ -3,6 +3,7 @@
 
 #include "whitted/core/packet_array.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace whitted {
@@ -32,6 +33,12 @@ Color LectureShading::trace(const Ray& ray, int hits_so_far, RayCounts& counts) 
     Color radiance;
     trace_packet(&ray, 1, hits_so_far, &radiance, counts);
     return radiance;
+}
+
+double LectureShading::schlick_fresnel(double r0, double n_dot_v) {
+    if (!(n_dot_v >= 0)) return 0.0;  // seen from behind (only with normals as given): no glaze
+    const double c = 1.0 - n_dot_v;
+    return r0 + (1.0 - r0) * (c * c * c * c * c);
 }
 
 double LectureShading::specular_lobe(const Material& material, const Vec3& normal, const Vec3& to_eye,
@@ -85,9 +92,11 @@ template <class Observer>
 void LectureShading::direct_lighting_with(const SurfaceHit* hits, const Ray* rays, const bool* active, int count,
                                           Color* local, Vec3* normal, RayCounts& counts, int level,
                                           Observer& observer) const {
+    const bool course = m_scene.convention == Convention::course;
     for (int i = 0; i < count; ++i) {
         if (!active[i]) continue;
-        normal[i] = facing_normal(hits[i], rays[i]);
+        // The course's ray tracer uses every normal as it is, so a back face is shaded dark.
+        normal[i] = course ? hits[i].normal : facing_normal(hits[i], rays[i]);
         local[i] = m_scene.materials[hits[i].material].ka * m_scene.ambient;  // ambient: ka·Ia
         observer.hit(i, level, rays[i], hits[i], normal[i]);
         observer.ambient(i, level, local[i]);
@@ -114,6 +123,16 @@ void LectureShading::direct_lighting_with(const SurfaceHit* hits, const Ray* ray
             }
             n_dot_l[i] = dot(normal[i], to_light);
             if constexpr (Observer::watching) shadow_rays[i].direction = to_light;  // l, also where unlit
+            if (course) {
+                // No gate: diffuse max(0, n·l), the highlight as it comes; the shadow ray spans
+                // (1e-6, 1) of the vector to the light.
+                n_dot_l[i] = std::max(0.0, n_dot_l[i]);
+                lit[i] = true;
+                shadow_rays[i] = {point, to_light, ray_limits::course_shadow_fraction * light_distance, light_distance};
+                query[i] = true;
+                counts.shadow += 1;
+                continue;
+            }
             // The gate on both terms: a light behind the surface adds nothing.
             if (!(n_dot_l[i] > ray_limits::cosine_epsilon)) continue;
             lit[i] = true;
@@ -206,19 +225,33 @@ void LectureShading::trace_packet_with(const Ray* first_rays, int count, int hit
                              observer);
         for (int i = 0; i < count; ++i) {
             if (!active[i]) continue;
-            const Color added = weight[i] * local[i];
+            const Material& material = m_scene.materials[hits[i].material];
+            const Vec3 to_eye = -rays[i].direction;
+            Color mirror_weight = material.km;
+            Color added;
+            if (material.fresnel_r0 >= 0) {
+                // Glazed: (1 − F)·(the other terms) + F·L(r), F from Schlick's approximation.
+                const double fresnel = schlick_fresnel(material.fresnel_r0, dot(normal[i], to_eye));
+                added = weight[i] * local[i] * (1.0 - fresnel);
+                mirror_weight = Color(fresnel);
+            } else {
+                added = weight[i] * local[i];
+            }
             radiance[i] += added;
             observer.local(i, level, weight[i], local[i], added);
-            const Material& material = m_scene.materials[hits[i].material];
-            if (is_zero(material.km) || level + 1 >= m_scene.max_depth) {
+            if (is_zero(mirror_weight) || level + 1 >= m_scene.max_depth) {
                 active[i] = false;
                 continue;
             }
+            const Color next_weight = weight[i] * mirror_weight;
+            if (std::max({next_weight.x, next_weight.y, next_weight.z}) < m_scene.min_weight) {
+                active[i] = false;  // render.min_weight: too faint a path to trace further
+                continue;
+            }
             // Mirror: r = 2(n·v)n − v, from the hit point itself (no offset; t_min does the work).
-            const Vec3 to_eye = -rays[i].direction;
             const Vec3 mirror_direction = normalize(normal[i] * (2.0 * dot(normal[i], to_eye)) - to_eye);
             rays[i] = {hits[i].point, mirror_direction, ray_limits::surface_t_min, ray_limits::max_distance};
-            weight[i] = weight[i] * material.km;
+            weight[i] = next_weight;
             observer.mirror(i, level, rays[i], weight[i]);
             ++counts.reflected;
         }

@@ -89,6 +89,9 @@ public:
     /// max(0, r_v·l)^p (Phong). Unit vectors in; `to_eye` is v.
     static double specular_lobe(const Material& material, const Vec3& normal, const Vec3& to_eye, const Vec3& to_light);
 
+    /// Schlick's Fresnel factor F = R0 + (1 − R0)(1 − n·v)^5, and 0 where n·v < 0.
+    static double schlick_fresnel(double r0, double n_dot_v);
+
     /// n turned toward where the ray came from: surfaces are two-sided.
     static Vec3 facing_normal(const SurfaceHit& hit, const Ray& ray) {
         return dot(hit.normal, ray.direction) > 0 ? -hit.normal : hit.normal;

@@ -31,6 +31,10 @@ struct Located {
 enum class CameraType { perspective, orthographic };
 enum class LightType { point, directional };
 enum class Highlight { blinn, phong };
+/// Shading conventions (docs/scene-format.md §2.3): `pov` is POV-Ray 3.7's, the default;
+/// `course` the Cornell CS4620 ray tracer's (normals as given, its shadow-ray span, no n·l gate
+/// on the highlight).
+enum class Convention { pov, course };
 
 struct CameraDescription {
     SourceLocation where;
@@ -39,7 +43,14 @@ struct CameraDescription {
     Located<Vec3> look_at;
     Located<Vec3> up{Vec3{0, 1, 0}};
     Located<double> fov{45.0};        ///< horizontal, degrees (perspective)
-    Located<double> view_width{0.0};  ///< world units (orthographic)
+    Located<double> view_width{0.0};  ///< world units (orthographic; perspective with a window)
+    // The image-plane window (docs/scene-format.md §2.1): a perspective camera with
+    // `view_height` aims its rays through a view_width × view_height rectangle centred
+    // projection_distance along the view direction, on a plane perpendicular to
+    // image_plane_normal (default: the view direction itself).
+    Located<double> view_height{0.0};
+    Located<double> projection_distance{1.0};
+    Located<Vec3> image_plane_normal;  ///< `given` = false: perpendicular to the view direction
 };
 
 struct ImageDescription {
@@ -68,6 +79,9 @@ struct MaterialDescription {
     Located<double> p{1.0};
     Located<Color> km{Color{0.0}};
     Located<Highlight> highlight{Highlight::blinn};
+    /// Given: the mirror weight is Schlick's Fresnel factor F for this index of refraction
+    /// instead of km, and the other terms are weighted by 1 − F (the course's "Glazed").
+    Located<double> fresnel_ior{0.0};
 };
 
 /// `material:` on an object: a name from `materials`, or an inline map.
@@ -127,6 +141,8 @@ struct SceneDescription {
     Located<int64_t> max_depth{5};
     /// render.layers: the EXR render layers asked for, as written (docs/layers.md).
     std::vector<Located<std::string>> layers;
+    Located<Convention> convention{Convention::pov};
+    Located<double> min_weight{0.0};  ///< a mirror ray whose path weight is below this is not traced
     Located<Color> ambient{Color{1.0}};
     std::vector<LightDescription> lights;
     std::vector<MaterialDescription> materials;  ///< in file order
@@ -149,7 +165,8 @@ inline constexpr int64_t max_triangles = int64_t(64) << 20;  // 67 M triangles
 inline constexpr int64_t max_yaml_nodes = 10'000'000;        ///< stops alias ("billion laughs") bombs
 }  // namespace limits
 
-/// Reads a scene file (YAML or JSON). Throws InputError naming file:line:col on any problem.
+/// Reads a scene file (YAML or JSON; a `.xml` file is read as a Cornell CS4620 course scene,
+/// course_xml.h). Throws InputError naming file:line:col on any problem.
 SceneDescription parse_scene_file(const std::string& path);
 /// Same, from text already in memory; `path` is used for messages and relative mesh paths.
 SceneDescription parse_scene_text(const std::string& text, const std::string& path);

@@ -3,6 +3,7 @@
 // and column; every mistake becomes an InputError at the place it was made. Ranges that need
 // more than one value (eye ≠ look_at, min < max, ...) are checked in validate.cpp.
 
+#include "whitted/scene/course_xml.h"
 #include "whitted/scene/description.h"
 #include "whitted/scene/text_checks.h"
 
@@ -226,8 +227,19 @@ void count_nodes(ParseContext& ctx, const YAML::Node& node, int depth) {
     }
 }
 
+/// The image-plane window keys (the Cornell course's camera); a perspective camera with
+/// `view_height` needs `view_width` too.
+void parse_camera_window(const MapReader& map, CameraDescription& camera) {
+    map.number(camera.view_height, "view_height");
+    map.number(camera.projection_distance, "projection_distance");
+    map.vec3(camera.image_plane_normal, "image_plane_normal");
+    if (camera.type.value == CameraType::perspective && camera.view_height.given) map.require("view_width");
+}
+
 CameraDescription parse_camera(ParseContext& ctx, const YAML::Node& node) {
-    MapReader map(ctx, node, "camera", {"type", "eye", "look_at", "up", "fov", "view_width"});
+    MapReader map(ctx, node, "camera",
+                  {"type", "eye", "look_at", "up", "fov", "view_width", "view_height", "projection_distance",
+                   "image_plane_normal"});
     CameraDescription camera;
     camera.where = map.where();
     map.read(camera.type, "type", [](const ParseContext& c, const YAML::Node& n, const std::string& w) {
@@ -239,6 +251,7 @@ CameraDescription parse_camera(ParseContext& ctx, const YAML::Node& node) {
     map.vec3(camera.up, "up");
     map.number(camera.fov, "fov");
     map.number(camera.view_width, "view_width", camera.type.value == CameraType::orthographic);
+    parse_camera_window(map, camera);
     return camera;
 }
 
@@ -275,7 +288,7 @@ LightDescription parse_light(ParseContext& ctx, const YAML::Node& node, const st
 }
 
 MaterialDescription parse_material(ParseContext& ctx, const YAML::Node& node, const std::string& what) {
-    MapReader map(ctx, node, what, {"ka", "kd", "ks", "p", "km", "highlight"});
+    MapReader map(ctx, node, what, {"ka", "kd", "ks", "p", "km", "highlight", "fresnel_ior"});
     MaterialDescription material;
     material.where = map.where();
     map.color(material.ka, "ka");
@@ -286,6 +299,10 @@ MaterialDescription parse_material(ParseContext& ctx, const YAML::Node& node, co
     map.read(material.highlight, "highlight", [](const ParseContext& c, const YAML::Node& n, const std::string& w) {
         return parse_choice<Highlight>(c, n, w, {{"blinn", Highlight::blinn}, {"phong", Highlight::phong}});
     });
+    map.number(material.fresnel_ior, "fresnel_ior");
+    if (material.fresnel_ior.given && material.km.given)
+        ctx.fail(map.get("fresnel_ior"),
+                 what + ": give km or fresnel_ior, not both (fresnel_ior sets the mirror weight)");
     return material;
 }
 
@@ -506,6 +523,15 @@ std::vector<Located<std::string>> parse_render_layers(ParseContext& ctx, const Y
     return layers;
 }
 
+/// `render.convention` and `render.min_weight`: the Cornell course's shading rules, kept out of
+/// the default (POV-Ray's) path.
+void parse_render_conventions(const MapReader& render, SceneDescription& scene) {
+    render.read(scene.convention, "convention", [](const ParseContext& c, const YAML::Node& n, const std::string& w) {
+        return parse_choice<Convention>(c, n, w, {{"pov", Convention::pov}, {"course", Convention::course}});
+    });
+    render.number(scene.min_weight, "min_weight");
+}
+
 SceneDescription parse_document(ParseContext& ctx, const YAML::Node& root) {
     if (!root || root.IsNull())
         throw InputError({ctx.file, 1, 1}, "the scene is empty: expected a map with 'camera', 'image' and 'objects'");
@@ -522,11 +548,12 @@ SceneDescription parse_document(ParseContext& ctx, const YAML::Node& root) {
     scene.camera = parse_camera(ctx, map.require("camera"));
     scene.image = parse_image(ctx, map.require("image"));
     if (map.has("render")) {
-        MapReader render(ctx, map.get("render"), "render", {"max_depth", "layers"});
+        MapReader render(ctx, map.get("render"), "render", {"max_depth", "layers", "convention", "min_weight"});
         render.integer(scene.max_depth, "max_depth");
         if (render.has("layers")) scene.layers = parse_render_layers(ctx, render.get("layers"));
+        parse_render_conventions(render, scene);
     } else {
-        scene.max_depth.where = map.where();
+        scene.max_depth.where = scene.convention.where = scene.min_weight.where = map.where();
     }
     map.color(scene.ambient, "ambient");
     if (map.has("lights")) {
@@ -621,6 +648,7 @@ SceneDescription parse_scene_text(const std::string& text, const std::string& pa
 }
 
 SceneDescription parse_scene_file(const std::string& path) {
+    if (is_course_xml_path(path)) return parse_course_xml_file(path);  // the Cornell course's XML scenes
     return parse_scene_text(read_text_file(path, limits::max_scene_file_bytes, "scene file"), path);
 }
 

@@ -23,6 +23,9 @@ struct Material {
     double p = 1;  ///< specular exponent
     Color km;      ///< mirror
     Highlight highlight = Highlight::blinn;
+    /// Schlick's R0 = ((η−1)/(η+1))² when the material has `fresnel_ior`, else negative: km is
+    /// then the mirror weight, unscaled.
+    double fresnel_r0 = -1;
 };
 
 struct Camera {
@@ -88,6 +91,8 @@ struct Scene {
     int width = 0, height = 0;
     int samples = 1;
     int max_depth = 5;
+    Convention convention = Convention::pov;
+    double min_weight = 0;  ///< mirror rays whose path weight (largest channel) is below it are not traced
     Color background;
     Color ambient;  ///< I_a
     Camera camera;

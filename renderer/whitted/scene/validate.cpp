@@ -4,10 +4,12 @@
 
 #include "whitted/render/layers.h"
 #include "whitted/scene/mesh_file.h"
+#include "whitted/scene/msh_file.h"
 #include "whitted/scene/scene.h"
 #include "whitted/scene/text_checks.h"
 
 #include <cmath>
+#include <filesystem>
 #include <numbers>
 #include <unordered_map>
 
@@ -26,13 +28,27 @@ void require_non_zero(const Located<Vec3>& v, const std::string& what) {
     if (is_zero(v.value)) fail(v.where, what + " must not be the zero vector");
 }
 
+/// Schlick's normal-incidence reflectance R0 = ((η−1)/(η+1))² for `fresnel_ior` = η.
+double fresnel_r0(const Located<double>& ior, const std::string& what) {
+    if (!(ior.value > 0)) fail(ior.where, what + ".fresnel_ior: the index of refraction must be > 0");
+    const double r = (ior.value - 1) / (ior.value + 1);
+    return r * r;
+}
+
+/// The course's .msh meshes are told apart from OBJ files by their extension.
+bool is_msh_file(const std::string& path) {
+    return std::filesystem::path(path).extension() == ".msh";
+}
+
 Material make_material(const MaterialDescription& d, const std::string& what) {
     require_non_negative(d.ka, what + ".ka");
     require_non_negative(d.kd, what + ".kd");
     require_non_negative(d.ks, what + ".ks");
     require_non_negative(d.km, what + ".km");
     if (!(d.p.value > 0)) fail(d.p.where, what + ".p: the specular exponent must be > 0");
-    return {d.ka.value, d.kd.value, d.ks.value, d.p.value, d.km.value, d.highlight.value};
+    Material material{d.ka.value, d.kd.value, d.ks.value, d.p.value, d.km.value, d.highlight.value};
+    if (d.fresnel_ior.given) material.fresnel_r0 = fresnel_r0(d.fresnel_ior, what);
+    return material;
 }
 
 class SceneBuilder {
@@ -156,7 +172,9 @@ private:
         MeshData data;
         try {
             // With the object's own material the MTL files are not needed (nor read).
-            data = load_obj_mesh(object.file_path, object.file.where, 0, !object.material);
+            data = is_msh_file(object.file_path)
+                       ? load_msh_mesh(object.file_path, object.file.where)
+                       : load_obj_mesh(object.file_path, object.file.where, 0, !object.material);
         } catch (const InputError& e) {
             if (e.where().file == object.file.where.file) throw;
             throw with_reference(e);
@@ -293,6 +311,34 @@ Transform make_transform(const std::vector<TransformStep>& steps) {
     return result;
 }
 
+namespace {
+/// A perspective camera aimed through a window (the Cornell course's camera): the window's
+/// centre is projection_distance along the unit view direction; its plane has the unit normal
+/// w = image_plane_normal (default −forward), screen up V = `up` projected into that plane and
+/// screen right U = V × w; the window spans view_width·U by view_height·V. With an oblique w
+/// the window is not perpendicular to the view direction, which gives the course's sheared views.
+void make_window_camera(const CameraDescription& d, const Vec3& forward, Camera& camera) {
+    if (!(d.view_width.value > 0)) fail(d.view_width.where, "camera.view_width must be > 0");
+    if (!(d.view_height.value > 0)) fail(d.view_height.where, "camera.view_height must be > 0");
+    if (!(d.projection_distance.value > 0)) fail(d.projection_distance.where, "camera.projection_distance must be > 0");
+    Vec3 w = -forward;
+    if (d.image_plane_normal.given) {
+        require_non_zero(d.image_plane_normal, "camera.image_plane_normal");
+        w = normalize(d.image_plane_normal.value);
+        if (!(std::fabs(dot(w, forward)) > 1e-9))
+            fail(d.image_plane_normal.where, "camera.image_plane_normal is perpendicular to the view direction");
+    }
+    const Vec3 up_in_plane = d.up.value - w * dot(d.up.value, w);
+    if (length(up_in_plane) <= 1e-9 * length(d.up.value))
+        fail(d.up.where, "camera.up is parallel to image_plane_normal; pick another up");
+    const Vec3 screen_up = normalize(up_in_plane);
+    const Vec3 screen_right = cross(screen_up, w);
+    camera.forward = forward * d.projection_distance.value;
+    camera.right = screen_right * d.view_width.value;
+    camera.up = screen_up * d.view_height.value;
+}
+}  // namespace
+
 Camera make_camera(const CameraDescription& d, int width, int height) {
     const Vec3 view = d.look_at.value - d.eye.value;
     if (is_zero(view)) fail(d.look_at.where, "camera: look_at must differ from eye");
@@ -309,7 +355,9 @@ Camera make_camera(const CameraDescription& d, int width, int height) {
     Camera camera;
     camera.type = d.type.value;
     camera.eye = d.eye.value;
-    if (d.type.value == CameraType::perspective) {
+    if (d.type.value == CameraType::perspective && d.view_height.given) {
+        make_window_camera(d, forward, camera);
+    } else if (d.type.value == CameraType::perspective) {
         if (!(d.fov.value > 0 && d.fov.value < 180))
             fail(d.fov.where,
                  "camera.fov must be between 0 and 180 degrees (exclusive), got " + std::to_string(d.fov.value));
@@ -321,7 +369,9 @@ Camera make_camera(const CameraDescription& d, int width, int height) {
         if (!(d.view_width.value > 0)) fail(d.view_width.where, "camera.view_width must be > 0");
         camera.forward = forward;
         camera.right = right_unit * d.view_width.value;
-        camera.up = up_unit * (d.view_width.value / aspect);
+        if (d.view_height.given && !(d.view_height.value > 0))
+            fail(d.view_height.where, "camera.view_height must be > 0");
+        camera.up = up_unit * (d.view_height.given ? d.view_height.value : d.view_width.value / aspect);
     }
     return camera;
 }
@@ -352,6 +402,10 @@ Scene validate_scene(const SceneDescription& d) {
         }
         scene.layers.push_back(layer.value);
     }
+    if (!(d.min_weight.value >= 0 && d.min_weight.value <= 1))
+        fail(d.min_weight.where, "render.min_weight must be between 0 and 1");
+    scene.convention = d.convention.value;
+    scene.min_weight = d.min_weight.value;
     scene.width = static_cast<int>(image.width.value);
     scene.height = static_cast<int>(image.height.value);
     scene.samples = static_cast<int>(image.samples.value);

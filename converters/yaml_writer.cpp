@@ -1,0 +1,192 @@
+// SPDX-License-Identifier: MIT
+#include "converters/yaml_writer.h"
+
+#include "whitted/output/atomic_files.h"
+
+#include <charconv>
+#include <filesystem>
+
+namespace whitted::yaml {
+namespace {
+
+/// The shortest text that parses back to exactly `value` (std::to_chars' guarantee).
+std::string number(double value) {
+    char buffer[64];
+    const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+    return std::string(buffer, result.ptr);
+}
+std::string integer(int64_t value) {
+    return std::to_string(value);
+}
+std::string vec3(const Vec3& v) {
+    return "[" + number(v.x) + ", " + number(v.y) + ", " + number(v.z) + "]";
+}
+
+/// A double-quoted YAML string (names and paths may hold any character).
+std::string quoted(const std::string& text) {
+    std::string out = "\"";
+    for (const unsigned char c : text) {
+        if (c == '"' || c == '\\') {
+            out += '\\';
+            out += char(c);
+        } else if (c < 0x20) {
+            char escape[8];
+            std::snprintf(escape, sizeof escape, "\\x%02x", c);
+            out += escape;
+        } else {
+            out += char(c);
+        }
+    }
+    return out + "\"";
+}
+
+std::string material_map(const MaterialDescription& m) {
+    std::string out = "{ ka: " + vec3(m.ka.value) + ", kd: " + vec3(m.kd.value) + ", ks: " + vec3(m.ks.value) +
+                      ", p: " + number(m.p.value);
+    if (m.fresnel_ior.given)
+        out += ", fresnel_ior: " + number(m.fresnel_ior.value);
+    else
+        out += ", km: " + vec3(m.km.value);
+    out += std::string(", highlight: ") + (m.highlight.value == Highlight::blinn ? "blinn" : "phong") + " }";
+    return out;
+}
+
+std::string transform_steps(const std::vector<TransformStep>& steps) {
+    std::string out = "[";
+    for (size_t i = 0; i < steps.size(); ++i) {
+        const TransformStep& s = steps[i];
+        out += i ? ", " : "";
+        switch (s.kind) {
+            case TransformStep::Kind::scale:
+                out += "{ scale: " + vec3(s.vector) + " }";
+                break;
+            case TransformStep::Kind::translate:
+                out += "{ translate: " + vec3(s.vector) + " }";
+                break;
+            case TransformStep::Kind::rotate:
+                out += "{ rotate: { axis: " + vec3(s.vector) + ", angle: " + number(s.angle) + " } }";
+                break;
+            case TransformStep::Kind::matrix: {
+                out += "{ matrix: [";
+                for (size_t k = 0; k < 16; ++k) out.append(k ? ", " : "").append(number(s.matrix[k]));
+                out += "] }";
+                break;
+            }
+        }
+    }
+    return out + "]";
+}
+
+class Writer {
+public:
+    explicit Writer(const std::string& output_path) {
+        std::error_code error;
+        const std::filesystem::path parent = std::filesystem::path(output_path).parent_path();
+        m_directory = parent.empty() ? std::filesystem::current_path(error) : std::filesystem::absolute(parent, error);
+    }
+
+    std::string mesh_path(const ObjectDescription& o) const {
+        std::error_code error;
+        const std::filesystem::path file = std::filesystem::absolute(o.file_path, error);
+        const std::filesystem::path relative = std::filesystem::relative(file, m_directory, error);
+        return error || relative.empty() ? file.string() : relative.string();
+    }
+
+    void objects(const std::vector<ObjectDescription>& list, const std::string& indent, std::string& out) const {
+        for (const ObjectDescription& o : list) {
+            out += indent + "- type: " + to_string(o.type) + "\n";
+            const std::string in = indent + "  ";
+            if (!o.transform.empty()) out += in + "transform: " + transform_steps(o.transform) + "\n";
+            if (o.material) {
+                out += in + "material: " +
+                       (o.material->inline_ ? material_map(*o.material->inline_) : quoted(o.material->name)) + "\n";
+            }
+            switch (o.type) {
+                case ObjectType::sphere:
+                    out +=
+                        in + "center: " + vec3(o.center.value) + "\n" + in + "radius: " + number(o.radius.value) + "\n";
+                    break;
+                case ObjectType::plane:
+                    out += in + "point: " + vec3(o.point.value) + "\n" + in + "normal: " + vec3(o.normal.value) + "\n";
+                    break;
+                case ObjectType::box:
+                    out += in + "min: " + vec3(o.min.value) + "\n" + in + "max: " + vec3(o.max.value) + "\n";
+                    break;
+                case ObjectType::triangle:
+                case ObjectType::mesh:
+                    if (o.type == ObjectType::mesh && o.file.given) {
+                        out += in + "file: " + quoted(mesh_path(o)) + "\n";
+                        break;
+                    }
+                    out += in + "vertices: [";
+                    for (size_t i = 0; i < o.vertices.size(); ++i)
+                        out.append(i ? ", " : "").append(vec3(o.vertices[i]));
+                    out += "]\n";
+                    if (o.type == ObjectType::triangle) break;
+                    out += in + "triangles: [";
+                    for (size_t i = 0; i < o.triangles.size(); ++i)
+                        out.append(i ? ", [" : "[") += integer(o.triangles[i][0]) + ", " + integer(o.triangles[i][1]) +
+                                                       ", " + integer(o.triangles[i][2]) + "]";
+                    out += "]\n";
+                    if (!o.normals.empty()) {
+                        out += in + "normals: [";
+                        for (size_t i = 0; i < o.normals.size(); ++i)
+                            out.append(i ? ", " : "").append(vec3(o.normals[i]));
+                        out += "]\n";
+                    }
+                    break;
+                case ObjectType::group:
+                    out += in + "objects:" + (o.children.empty() ? " []\n" : "\n");
+                    objects(o.children, in + "  ", out);
+                    break;
+            }
+        }
+    }
+
+private:
+    std::filesystem::path m_directory;
+};
+
+}  // namespace
+
+std::string scene_to_yaml(const SceneDescription& scene, const std::string& output_path) {
+    const Writer writer(output_path);
+    std::string out = "# Converted by whitted convert from " + std::filesystem::path(scene.path).filename().string() +
+                      "; every value written out, defaults included.\nversion: 1\n";
+    const CameraDescription& c = scene.camera;
+    out += "camera:\n  type: " + std::string(c.type.value == CameraType::perspective ? "perspective" : "orthographic") +
+           "\n  eye: " + vec3(c.eye.value) + "\n  look_at: " + vec3(c.look_at.value) + "\n  up: " + vec3(c.up.value) +
+           "\n  fov: " + number(c.fov.value) + "\n";
+    if (c.view_width.given || c.type.value == CameraType::orthographic)
+        out += "  view_width: " + number(c.view_width.value) + "\n";
+    if (c.view_height.given) out += "  view_height: " + number(c.view_height.value) + "\n";
+    if (c.projection_distance.given) out += "  projection_distance: " + number(c.projection_distance.value) + "\n";
+    if (c.image_plane_normal.given) out += "  image_plane_normal: " + vec3(c.image_plane_normal.value) + "\n";
+    const ImageDescription& image = scene.image;
+    out += "image: { width: " + integer(image.width.value) + ", height: " + integer(image.height.value) +
+           ", background: " + vec3(image.background.value) + ", samples: " + integer(image.samples.value) + " }\n";
+    out += "render: { max_depth: " + integer(scene.max_depth.value) +
+           ", convention: " + (scene.convention.value == Convention::course ? "course" : "pov") +
+           ", min_weight: " + number(scene.min_weight.value) + " }\n";
+    out += "ambient: " + vec3(scene.ambient.value) + "\n";
+    out += "lights:" + std::string(scene.lights.empty() ? " []\n" : "\n");
+    for (const LightDescription& l : scene.lights) {
+        if (l.type == LightType::point)
+            out += "  - { type: point, position: " + vec3(l.position.value);
+        else
+            out += "  - { type: directional, direction: " + vec3(l.direction.value);
+        out += ", intensity: " + vec3(l.intensity.value) + " }\n";
+    }
+    out += "materials:" + std::string(scene.materials.empty() ? " {}\n" : "\n");
+    for (const MaterialDescription& m : scene.materials) out += "  " + quoted(m.name) + ": " + material_map(m) + "\n";
+    out += "objects:" + std::string(scene.objects.empty() ? " []\n" : "\n");
+    writer.objects(scene.objects, "  ", out);
+    return out;
+}
+
+void write_yaml_file(const SceneDescription& scene, const std::string& path) {
+    const std::string text = scene_to_yaml(scene, path);
+    write_files_atomically({{std::filesystem::path(path), text}});
+}
+
+}  // namespace whitted::yaml

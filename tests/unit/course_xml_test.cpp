@@ -1,0 +1,147 @@
+// SPDX-License-Identifier: MIT
+// The course's XML reader (docs/course-format.md): what each element becomes in the plain
+// description, with its place; the window camera against the course's formula written out here;
+// Schlick's factor against its closed form.
+
+#include "whitted/scene/course_xml.h"
+#include "whitted/render/camera.h"
+#include "whitted/render/shading.h"
+#include "whitted/scene/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace whitted {
+namespace {
+
+const char* const sphere_scene = R"(<?xml version="1.0"?>
+<scene>
+  <camera>
+    <viewPoint>5 4 3</viewPoint>
+    <viewDir>-5 -4 -3</viewDir>
+    <viewUp>0 1 0</viewUp>
+    <projDistance>5</projDistance>
+    <viewWidth>2.5</viewWidth>
+    <viewHeight>2</viewHeight>
+  </camera>
+  <image>30 20</image>
+  <shader name="blue" type="Phong"><diffuseColor>.2 .3 .8</diffuseColor><exponent>50</exponent></shader>
+  <surface type="Sphere"><shader ref="blue" /><radius>2</radius></surface>
+  <light><position>3 4 5</position></light>
+</scene>
+)";
+
+TEST(CourseXml, ElementsBecomeWhittedKeysWithTheirPlaces) {
+    const SceneDescription d = parse_course_xml_text(sphere_scene, "s.xml");
+    EXPECT_EQ(d.camera.eye.value, Vec3(5, 4, 3));
+    EXPECT_EQ(d.camera.look_at.value, Vec3(0, 0, 0));
+    EXPECT_EQ(d.camera.eye.where.line, 4);
+    EXPECT_EQ(d.camera.eye.where.column, 16);        // the first number, not the element
+    EXPECT_TRUE(d.camera.image_plane_normal.given);  // the 2010 camera: (0, 0, 1) by default
+    EXPECT_EQ(d.camera.image_plane_normal.value, Vec3(0, 0, 1));
+    EXPECT_EQ(d.camera.projection_distance.value, 5);
+    EXPECT_EQ(d.image.width.value, 30);
+    EXPECT_EQ(d.image.height.value, 20);
+    ASSERT_EQ(d.materials.size(), 1u);
+    EXPECT_EQ(d.materials[0].kd.value, Color(.2, .3, .8));
+    EXPECT_EQ(d.materials[0].ks.value, Color(1.0));  // the course's default specularColor
+    EXPECT_EQ(d.materials[0].ka.value, Color(0.0));
+    EXPECT_EQ(d.materials[0].p.value, 50);
+    ASSERT_EQ(d.objects.size(), 1u);
+    EXPECT_EQ(d.objects[0].center.value, Vec3(0, 0, 0));  // default centre
+    EXPECT_EQ(d.objects[0].radius.value, 2);
+    EXPECT_EQ(d.lights[0].intensity.value, Color(1.0));
+    EXPECT_EQ(d.convention.value, Convention::course);
+    EXPECT_EQ(d.ambient.value, Color(0.0));
+    EXPECT_EQ(d.max_depth.value, 11);
+    EXPECT_EQ(d.min_weight.value, 0.01);
+}
+
+TEST(CourseXml, ObliqueWindowCameraFollowsTheCourseFormula) {
+    const SceneDescription d = parse_course_xml_text(sphere_scene, "s.xml");
+    const Camera camera = make_camera(d.camera, 30, 20);
+    // The course: w = normalize(projNormal) = (0, 0, 1); V = up projected into the plane = (0, 1, 0);
+    // U = V × w = (1, 0, 0); centre = eye + 5·normalize(viewDir); pixel (x, y from the bottom).
+    const Vec3 eye(5, 4, 3), dir = normalize(Vec3(-5, -4, -3));
+    for (const auto& [x, y] : {std::pair{0, 0}, std::pair{29, 19}, std::pair{7, 13}}) {
+        const double u = (x + 0.5) / 30 - 0.5, v = (y + 0.5) / 20 - 0.5;
+        const Vec3 point = eye + dir * 5.0 + Vec3(1, 0, 0) * (u * 2.5) + Vec3(0, 1, 0) * (v * 2.0);
+        const Vec3 expected = normalize(point - eye);
+        // Whitted's row j counts from the top.
+        const int j = 19 - y;
+        const Ray ray = camera_ray(camera, (x + 0.5) / 30 - 0.5, 0.5 - (j + 0.5) / 20);
+        EXPECT_NEAR(ray.direction.x, expected.x, 1e-12);
+        EXPECT_NEAR(ray.direction.y, expected.y, 1e-12);
+        EXPECT_NEAR(ray.direction.z, expected.z, 1e-12);
+        EXPECT_EQ(ray.origin, eye);
+    }
+}
+
+TEST(CourseXml, GroupTransformsAreReversedAndRotationIsXThenYThenZ) {
+    const SceneDescription d = parse_course_xml_text(R"(<scene><camera/><image>1 1</image>
+<shader name="s" type="Lambertian"/>
+<surface type="Group"><translate>1 2 3</translate><rotate>10 20 30</rotate><scale>2 2 2</scale>
+<surface type="Sphere"><shader ref="s"/></surface></surface></scene>)",
+                                                     "g.xml");
+    ASSERT_EQ(d.objects.size(), 1u);
+    const auto& steps = d.objects[0].transform;
+    ASSERT_EQ(steps.size(), 5u);
+    EXPECT_EQ(steps[0].kind, TransformStep::Kind::scale);  // last in the file, first on the points
+    EXPECT_EQ(steps[1].kind, TransformStep::Kind::rotate);
+    EXPECT_EQ(steps[1].vector, Vec3(1, 0, 0));
+    EXPECT_EQ(steps[1].angle, 10);
+    EXPECT_EQ(steps[2].vector, Vec3(0, 1, 0));
+    EXPECT_EQ(steps[2].angle, 20);
+    EXPECT_EQ(steps[3].vector, Vec3(0, 0, 1));
+    EXPECT_EQ(steps[3].angle, 30);
+    EXPECT_EQ(steps[4].kind, TransformStep::Kind::translate);
+    // The children inherit nothing but the shader they name.
+    EXPECT_EQ(d.objects[0].children[0].material->name, "s");
+}
+
+TEST(CourseXml, GlazedTakesTheSubstrateAndTheIndex) {
+    const SceneDescription d = parse_course_xml_text(R"(<scene><camera/><image>1 1</image>
+<shader name="g" type="Glazed"><refractiveIndex>1.5</refractiveIndex>
+<substrate type="Lambertian"><diffuseColor>.4 .5 .8</diffuseColor></substrate></shader></scene>)",
+                                                     "g.xml");
+    ASSERT_EQ(d.materials.size(), 1u);
+    EXPECT_EQ(d.materials[0].kd.value, Color(.4, .5, .8));
+    EXPECT_EQ(d.materials[0].fresnel_ior.value, 1.5);
+    EXPECT_FALSE(d.materials[0].km.given);
+}
+
+TEST(CourseXml, MistakesNameLineAndColumn) {
+    const auto error_of = [](const std::string& text) {
+        try {
+            parse_course_xml_text(text, "bad.xml");
+        } catch (const InputError& e) {
+            return e.where().str() + " " + e.message();
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(error_of("<scene>\n  <camera><viewPoint>1 2 x</viewPoint></camera></scene>").rfind("bad.xml:2:26 ", 0),
+              0u)
+        << error_of("<scene>\n  <camera><viewPoint>1 2 x</viewPoint></camera></scene>");
+    EXPECT_NE(error_of("<scene>\n <bogus/></scene>").find("bad.xml:2:2 <scene>: unknown element <bogus>"),
+              std::string::npos);
+    EXPECT_NE(
+        error_of(
+            "<scene><camera/><image>1 1</image>\n<surface type=\"Sphere\"><shader ref=\"nope\"/></surface></scene>")
+            .find("bad.xml:2:24 unknown shader 'nope'"),
+        std::string::npos);
+    EXPECT_NE(error_of("<scene><camera>\n</scene>").find("XML syntax error"), std::string::npos);
+    EXPECT_NE(error_of("<scene><image>1 1</image><samples>8</samples><camera/></scene>").find("square number"),
+              std::string::npos);
+}
+
+TEST(Shading, SchlickFresnelClosedForm) {
+    const double r0 = 0.04;
+    EXPECT_DOUBLE_EQ(LectureShading::schlick_fresnel(r0, 1.0), 0.04);
+    EXPECT_DOUBLE_EQ(LectureShading::schlick_fresnel(r0, 0.0), 1.0);
+    EXPECT_DOUBLE_EQ(LectureShading::schlick_fresnel(r0, 0.5), 0.04 + 0.96 * 0.03125);
+    EXPECT_EQ(LectureShading::schlick_fresnel(r0, -0.1), 0.0);  // seen from behind
+}
+
+}  // namespace
+}  // namespace whitted
