@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace whitted {
@@ -144,13 +145,14 @@ inline constexpr int max_nesting = 64;  ///< groups inside groups
 inline constexpr int64_t max_scene_file_bytes = int64_t(256) << 20;
 inline constexpr int64_t max_mesh_file_bytes = int64_t(2) << 30;
 inline constexpr int64_t max_triangles = int64_t(64) << 20;  // 67 M triangles
-inline constexpr int64_t max_yaml_nodes = 10'000'000;        ///< stops alias ("billion laughs") bombs
+/// Values held at once while reading, and values all aliases stand for ("billion laughs").
+inline constexpr int64_t max_yaml_nodes = 10'000'000;
 }  // namespace limits
 
 /// Reads a scene file (YAML or JSON). Throws InputError naming file:line:col on any problem.
 SceneDescription parse_scene_file(const std::string& path);
 /// Same, from text already in memory; `path` is used for messages and relative mesh paths.
-SceneDescription parse_scene_text(const std::string& text, const std::string& path);
+SceneDescription parse_scene_text(std::string_view text, const std::string& path);
 
 const char* to_string(ObjectType type);
 
