@@ -11,6 +11,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -27,6 +28,35 @@ struct Located {
     T value{};
     SourceLocation where;
     bool given = false;  ///< written in the file, rather than defaulted
+};
+
+/// An optional value kept on the heap: 8 bytes in every object of the description, where a
+/// std::optional<T> would take all of sizeof(T) in each, set or not (a scene may have millions of
+/// objects and few inline materials). Reads like std::optional.
+template <class T>
+class Boxed {
+public:
+    Boxed() = default;
+    Boxed(const Boxed& other) : m_value(other.m_value ? std::make_unique<T>(*other.m_value) : nullptr) {}
+    Boxed(Boxed&&) noexcept = default;
+    Boxed& operator=(const Boxed& other) {
+        if (this != &other) m_value = other.m_value ? std::make_unique<T>(*other.m_value) : nullptr;
+        return *this;
+    }
+    Boxed& operator=(Boxed&&) noexcept = default;
+    Boxed& operator=(T value) {
+        m_value = std::make_unique<T>(std::move(value));
+        return *this;
+    }
+    explicit operator bool() const { return m_value != nullptr; }
+    bool has_value() const { return m_value != nullptr; }
+    const T& operator*() const { return *m_value; }
+    T& operator*() { return *m_value; }
+    const T* operator->() const { return m_value.get(); }
+    T* operator->() { return m_value.get(); }
+
+private:
+    std::unique_ptr<T> m_value;
 };
 
 enum class CameraType { perspective, orthographic };
@@ -74,8 +104,8 @@ struct MaterialDescription {
 /// `material:` on an object: a name from `materials`, or an inline map.
 struct MaterialReference {
     SourceLocation where;
-    std::string name;                            ///< set for a reference by name
-    std::optional<MaterialDescription> inline_;  ///< set for an inline material
+    std::string name;                    ///< set for a reference by name
+    Boxed<MaterialDescription> inline_;  ///< set for an inline material
 };
 
 struct TransformStep {

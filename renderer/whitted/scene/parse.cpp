@@ -55,23 +55,23 @@ std::string describe(const Node& node) {
 double parse_number(const ParseContext& ctx, const Node& node, const std::string& what) {
     if (!node.IsScalar() || node.IsQuoted()) ctx.fail(node, what + ": expected a number, got " + describe(node));
     const std::string_view whole = node.scalar_view();
-    const std::string text = printable(whole, 40);
+    const auto text = [&] { return printable(whole, 40); };  // for messages only
     std::string_view view = whole;
     if (!view.empty() && view.front() == '+') view.remove_prefix(1);
     // YAML's own spellings of the special values, so that they get the "finite" message below.
-    if (view.size() <= 9) {
+    if (view.size() <= 9 && !view.empty() && !std::isdigit(static_cast<unsigned char>(view.back()))) {
         std::string lowered(view);
         std::transform(lowered.begin(), lowered.end(), lowered.begin(), ::tolower);
         if (lowered == ".nan" || lowered == "nan" || lowered == ".inf" || lowered == "inf" || lowered == "-.inf" ||
             lowered == "-inf" || lowered == "infinity" || lowered == "-infinity")
-            ctx.fail(node, what + ": must be a finite number, got '" + text + "'");
+            ctx.fail(node, what + ": must be a finite number, got '" + text() + "'");
     }
     double value = 0;
     const auto [end, error] = std::from_chars(view.data(), view.data() + view.size(), value);
-    if (error == std::errc::result_out_of_range) ctx.fail(node, what + ": number '" + text + "' is out of range");
+    if (error == std::errc::result_out_of_range) ctx.fail(node, what + ": number '" + text() + "' is out of range");
     if (error != std::errc() || end != view.data() + view.size())
         ctx.fail(node, what + ": expected a number, got " + describe(node));
-    if (!std::isfinite(value)) ctx.fail(node, what + ": must be a finite number, got '" + text + "'");
+    if (!std::isfinite(value)) ctx.fail(node, what + ": must be a finite number, got '" + text() + "'");
     return value;
 }
 
@@ -141,6 +141,7 @@ public:
     MapReader(ParseContext& ctx, const Node& node, std::string what, std::vector<std::string> allowed)
         : m_ctx(ctx), m_node(node), m_what(std::move(what)), m_allowed(std::move(allowed)) {
         if (!node.IsMap()) ctx.fail(node, m_what + ": expected a map of keys, got " + describe(node));
+        m_keys.reserve(node.size());
         for (const auto& entry : node.pairs()) {
             const Node& key = entry.first;
             if (!key.IsScalar()) ctx.fail(key, m_what + ": keys must be plain names");
@@ -202,11 +203,10 @@ template <class Enum>
 Enum parse_choice(const ParseContext& ctx, const Node& node, const std::string& what,
                   const std::vector<std::pair<std::string, Enum>>& choices) {
     const std::string word = parse_string(ctx, node, what);
-    std::vector<std::string> names;
-    for (const auto& [name, value] : choices) {
+    for (const auto& [name, value] : choices)
         if (name == word) return value;
-        names.push_back(name);
-    }
+    std::vector<std::string> names;
+    for (const auto& choice : choices) names.push_back(choice.first);
     ctx.fail(node, what + ": unknown value '" + printable(word) + "'" + did_you_mean(word, names) +
                        "; expected one of: " + join(names));
 }
@@ -356,6 +356,7 @@ std::vector<ObjectDescription> parse_objects(ParseContext& ctx, const Node& node
     if (node.IsNull()) return {};
     if (node.IsStreamed()) {  // the top-level list, parsed while it was read
         if (ctx.objects_error) std::rethrow_exception(ctx.objects_error);
+        if (ctx.objects.size() < ctx.objects.capacity() / 2) ctx.objects.shrink_to_fit();
         return std::move(ctx.objects);
     }
     if (!node.IsSequence()) ctx.fail(node, what + ": expected a list of objects, got " + describe(node));
@@ -371,13 +372,10 @@ ObjectDescription parse_object(ParseContext& ctx, const Node& node, const std::s
     if (!type_node)
         ctx.fail(node, what + ": missing required key 'type' (sphere, plane, box, triangle, mesh or group)");
     ObjectDescription object;
-    object.type = parse_choice<ObjectType>(ctx, type_node, what + ".type",
-                                           {{"sphere", ObjectType::sphere},
-                                            {"plane", ObjectType::plane},
-                                            {"box", ObjectType::box},
-                                            {"triangle", ObjectType::triangle},
-                                            {"mesh", ObjectType::mesh},
-                                            {"group", ObjectType::group}});
+    static const std::vector<std::pair<std::string, ObjectType>> object_types = {
+        {"sphere", ObjectType::sphere},     {"plane", ObjectType::plane}, {"box", ObjectType::box},
+        {"triangle", ObjectType::triangle}, {"mesh", ObjectType::mesh},   {"group", ObjectType::group}};
+    object.type = parse_choice<ObjectType>(ctx, type_node, what + ".type", object_types);
     const std::string label = what + " (" + to_string(object.type) + ")";
     std::vector<std::string> keys{"type", "transform"};
     if (object.type != ObjectType::group) keys.push_back("material");
@@ -563,6 +561,13 @@ SceneDescription parse_scene_text(std::string_view text, const std::string& path
     ctx.directory = std::filesystem::path(path).parent_path().string();
     check_text_is_readable(text, path);
     yaml_tree::Document document;
+    // Room for as many objects as a file of one-line objects holds (a sphere takes 64 bytes of
+    // text at least): moving hundreds of thousands of descriptions each time the list grows cost
+    // more than reading them. Pages never written are never resident; what is left is given back.
+    try {
+        ctx.objects.reserve(std::min<size_t>(text.size() / 64, size_t(1) << 24));
+    } catch (const std::bad_alloc&) {  // a machine without overcommit: grow as needed
+    }
     // Each top-level object is parsed as soon as it is read; its first mistake is kept and
     // reported when parse_document reaches `objects`, so that mistakes are reported in the
     // order the keys are checked, as for the rest of the scene.
