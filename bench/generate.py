@@ -2,7 +2,12 @@
 # SPDX-License-Identifier: MIT
 """Writes the performance anchor scenes (docs/performance.md) into a directory:
 spheres.yaml, torus100k.yaml (+ torus100k.obj), torus1m.yaml (+ torus1m.obj).
-All 1280x960, max_depth 5, one sample per pixel, a glazed mirror floor and two point lights."""
+All 1280x960, max_depth 5, one sample per pixel, a glazed mirror floor and two point lights.
+
+  generate.py [OUT_DIR]                          the anchor scenes
+  generate.py --many N [--json] [OUT_DIR]        many-N.yaml (or .json): N small spheres on a
+                                                 mirror floor, 640x480, one point light, for
+                                                 measuring how parsing and memory scale with N"""
 import math
 import random
 import sys
@@ -78,9 +83,51 @@ objects:
     (out / f"{name}.yaml").write_text(text)
 
 
+def many_spheres(out: Path, n: int, as_json: bool) -> Path:
+    """N spheres of radius 0.02 scattered over a 20 x 20 square, one shared material; the text
+    is written the way a program would write it (one object a line), in YAML flow style or JSON."""
+    rng = random.Random(13)
+    side = 10.0
+    if as_json:
+        head = ('{"camera": {"eye": [0, 6, 14], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 60},\n'
+                ' "image": {"width": 640, "height": 480, "background": [0.05, 0.07, 0.1]},\n'
+                ' "lights": [{"type": "point", "position": [-5, 12, 8], "intensity": 1}],\n'
+                ' "materials": {"floor": {"kd": 0.5, "ka": 0.05, "km": 0.4},\n'
+                '               "ball": {"kd": [0.8, 0.3, 0.2], "ka": 0.05, "ks": 0.4, "p": 40}},\n'
+                ' "objects": [\n  {"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "material": "floor"}')
+        item = ',\n  {{"type": "sphere", "center": [{:.4f}, 0.02, {:.4f}], "radius": 0.02, "material": "ball"}}'
+        tail = "\n]}\n"
+    else:
+        head = ("camera: { eye: [0, 6, 14], look_at: [0, 0, 0], up: [0, 1, 0], fov: 60 }\n"
+                "image: { width: 640, height: 480, background: [0.05, 0.07, 0.1] }\n"
+                "lights:\n  - { type: point, position: [-5, 12, 8], intensity: 1 }\n"
+                "materials:\n  floor: { kd: 0.5, ka: 0.05, km: 0.4 }\n"
+                "  ball: { kd: [0.8, 0.3, 0.2], ka: 0.05, ks: 0.4, p: 40 }\n"
+                "objects:\n  - { type: plane, point: [0, 0, 0], normal: [0, 1, 0], material: floor }")
+        item = "\n  - {{ type: sphere, center: [{:.4f}, 0.02, {:.4f}], radius: 0.02, material: ball }}"
+        tail = "\n"
+    path = out / f"many-{n}.{'json' if as_json else 'yaml'}"
+    with path.open("w") as f:
+        f.write(head)
+        for start in range(0, n, 10000):
+            f.write("".join(item.format(rng.uniform(-side, side), rng.uniform(-side, side))
+                            for _ in range(min(10000, n - start))))
+        f.write(tail)
+    return path
+
+
 def main() -> None:
     # generate.py [OUT_DIR [NAME ...]]: all three anchors, or only those named (the POV-Ray
-    # tier's pov.torus100k makes torus100k alone).
+    # tier's pov.torus100k makes torus100k alone); generate.py --many N [--json] [OUT_DIR].
+    args = sys.argv[1:]
+    if args and args[0] == "--many":
+        n = int(args[1])
+        as_json = "--json" in args[2:]
+        rest = [a for a in args[2:] if a != "--json"]
+        out = Path(rest[0] if rest else "build/bench")
+        out.mkdir(parents=True, exist_ok=True)
+        print(many_spheres(out, n, as_json))
+        return
     out = Path(sys.argv[1] if len(sys.argv) > 1 else "build/bench")
     names = set(sys.argv[2:]) or {"spheres", "torus100k", "torus1m"}
     unknown = names - {"spheres", "torus100k", "torus1m"}

@@ -4,9 +4,10 @@
 
 find_package(Threads REQUIRED)
 find_package(PkgConfig REQUIRED)
+# libyaml (libyaml-dev): the YAML parser behind the scene reader's fast scanner (yaml_tree.cpp).
+pkg_check_modules(LIBYAML REQUIRED IMPORTED_TARGET yaml-0.1)
 find_package(embree 3 CONFIG REQUIRED)
 find_package(TBB CONFIG REQUIRED)
-find_package(yaml-cpp CONFIG REQUIRED)
 find_package(CLI11 CONFIG REQUIRED)
 find_package(fmt CONFIG REQUIRED)
 find_package(nlohmann_json CONFIG REQUIRED)

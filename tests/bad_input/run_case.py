@@ -3,6 +3,7 @@
 """Runs one case of the bad-input catalogue (cases.txt) through `whitted render` and checks
 what a user relies on when the input is wrong:
   - the exit code is the expected one (2 for bad input);
+  - stderr holds no control character but newlines (a scene's text must not drive the terminal);
   - stderr holds the expected message fragment and names the scene file;
   - the existing output image is byte-for-byte unchanged and no temporary file is left;
   - no sanitizer report (when built with --sanitize), no crash, no hang.
@@ -55,6 +56,9 @@ def main():
         problems.append(f"stderr lacks '{fragment}'")
     if scene not in stderr:
         problems.append(f"stderr does not name the scene file '{scene}'")
+    raw = sorted({hex(b) for b in result.stderr if b < 0x20 and b != 0x0A})
+    if raw:
+        problems.append(f"stderr holds raw control characters {raw}")
     for marker in SANITIZER_MARKERS:
         if marker in stderr:
             problems.append(f"sanitizer report ({marker})")

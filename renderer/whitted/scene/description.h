@@ -11,8 +11,10 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace whitted {
@@ -26,6 +28,35 @@ struct Located {
     T value{};
     SourceLocation where;
     bool given = false;  ///< written in the file, rather than defaulted
+};
+
+/// An optional value kept on the heap: 8 bytes in every object of the description, where a
+/// std::optional<T> would take all of sizeof(T) in each, set or not (a scene may have millions of
+/// objects and few inline materials). Reads like std::optional.
+template <class T>
+class Boxed {
+public:
+    Boxed() = default;
+    Boxed(const Boxed& other) : m_value(other.m_value ? std::make_unique<T>(*other.m_value) : nullptr) {}
+    Boxed(Boxed&&) noexcept = default;
+    Boxed& operator=(const Boxed& other) {
+        if (this != &other) m_value = other.m_value ? std::make_unique<T>(*other.m_value) : nullptr;
+        return *this;
+    }
+    Boxed& operator=(Boxed&&) noexcept = default;
+    Boxed& operator=(T value) {
+        m_value = std::make_unique<T>(std::move(value));
+        return *this;
+    }
+    explicit operator bool() const { return m_value != nullptr; }
+    bool has_value() const { return m_value != nullptr; }
+    const T& operator*() const { return *m_value; }
+    T& operator*() { return *m_value; }
+    const T* operator->() const { return m_value.get(); }
+    T* operator->() { return m_value.get(); }
+
+private:
+    std::unique_ptr<T> m_value;
 };
 
 enum class CameraType { perspective, orthographic };
@@ -87,8 +118,8 @@ struct MaterialDescription {
 /// `material:` on an object: a name from `materials`, or an inline map.
 struct MaterialReference {
     SourceLocation where;
-    std::string name;                            ///< set for a reference by name
-    std::optional<MaterialDescription> inline_;  ///< set for an inline material
+    std::string name;                    ///< set for a reference by name
+    Boxed<MaterialDescription> inline_;  ///< set for an inline material
 };
 
 struct TransformStep {
@@ -162,14 +193,15 @@ inline constexpr int max_nesting = 64;  ///< groups inside groups
 inline constexpr int64_t max_scene_file_bytes = int64_t(256) << 20;
 inline constexpr int64_t max_mesh_file_bytes = int64_t(2) << 30;
 inline constexpr int64_t max_triangles = int64_t(64) << 20;  // 67 M triangles
-inline constexpr int64_t max_yaml_nodes = 10'000'000;        ///< stops alias ("billion laughs") bombs
+/// Values held at once while reading, and values all aliases stand for ("billion laughs").
+inline constexpr int64_t max_yaml_nodes = 10'000'000;
 }  // namespace limits
 
 /// Reads a scene file (YAML or JSON; a `.xml` file is read as a Cornell CS4620 course scene,
 /// course_xml.h). Throws InputError naming file:line:col on any problem.
 SceneDescription parse_scene_file(const std::string& path);
 /// Same, from text already in memory; `path` is used for messages and relative mesh paths.
-SceneDescription parse_scene_text(const std::string& text, const std::string& path);
+SceneDescription parse_scene_text(std::string_view text, const std::string& path);
 
 const char* to_string(ObjectType type);
 

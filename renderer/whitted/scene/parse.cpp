@@ -1,98 +1,102 @@
 // SPDX-License-Identifier: MIT
 // Scene format v1 (YAML, or JSON as YAML) → SceneDescription. Every value keeps its file, line
 // and column; every mistake becomes an InputError at the place it was made. Ranges that need
-// more than one value (eye ≠ look_at, min < max, ...) are checked in validate.cpp.
+// more than one value (eye ≠ look_at, min < max, ...) are checked in validate.cpp. The text is
+// read into a yaml_tree::Document (yaml_tree.h), whose top-level `objects` items are parsed here
+// one by one as they are read, so that a scene of a million spheres never holds a million trees.
 
 #include "whitted/scene/course_xml.h"
 #include "whitted/scene/description.h"
 #include "whitted/scene/text_checks.h"
 
-#include <yaml-cpp/yaml.h>
+#include "whitted/scene/yaml_tree.h"
 
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <exception>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 namespace whitted {
 namespace {
 
-struct ParseContext {
-    std::string file;
-    std::string directory;
-    int64_t nodes_seen = 0;
+using Node = yaml_tree::Node;
 
-    SourceLocation at(const YAML::Node& node) const {
-        const YAML::Mark mark = node.Mark();
-        if (mark.is_null()) return {file, 0, 0};
-        return {file, mark.line + 1, mark.column + 1};
+struct ParseContext {
+    FileName file;
+    std::string directory;
+    std::vector<ObjectDescription> objects;  ///< the top-level objects, parsed as they are read
+    std::exception_ptr objects_error;        ///< the first mistake in them, reported in turn
+
+    SourceLocation at(const Node& node) const {
+        SourceLocation where = node.location();
+        if (where.file.empty()) where.file = file;
+        return where;
     }
-    [[noreturn]] void fail(const YAML::Node& node, const std::string& message) const {
-        throw InputError(at(node), message);
-    }
+    [[noreturn]] void fail(const Node& node, const std::string& message) const { throw InputError(at(node), message); }
 };
 
-std::string describe(const YAML::Node& node) {
-    switch (node.Type()) {
-        case YAML::NodeType::Null:
+std::string describe(const Node& node) {
+    switch (node.kind()) {
+        case yaml_tree::Kind::null:
             return "nothing (null)";
-        case YAML::NodeType::Sequence:
+        case yaml_tree::Kind::sequence:
             return "a list";
-        case YAML::NodeType::Map:
+        case yaml_tree::Kind::map:
             return "a map";
-        case YAML::NodeType::Scalar: {
-            std::string s = node.Scalar();
-            if (s.size() > 40) s = s.substr(0, 37) + "...";
-            return node.Tag() == "!" ? "the string \"" + s + "\"" : "'" + s + "'";
+        case yaml_tree::Kind::scalar: {
+            const std::string s = printable(node.scalar_view(), 40);
+            return node.IsQuoted() ? "the string \"" + s + "\"" : "'" + s + "'";
         }
         default:
             return "nothing";
     }
 }
 
-double parse_number(const ParseContext& ctx, const YAML::Node& node, const std::string& what) {
-    if (!node.IsScalar() || node.Tag() == "!") ctx.fail(node, what + ": expected a number, got " + describe(node));
-    std::string text = node.Scalar();
-    std::string_view view = text;
+double parse_number(const ParseContext& ctx, const Node& node, const std::string& what) {
+    if (!node.IsScalar() || node.IsQuoted()) ctx.fail(node, what + ": expected a number, got " + describe(node));
+    const std::string_view whole = node.scalar_view();
+    const auto text = [&] { return printable(whole, 40); };  // for messages only
+    std::string_view view = whole;
     if (!view.empty() && view.front() == '+') view.remove_prefix(1);
     // YAML's own spellings of the special values, so that they get the "finite" message below.
-    std::string lowered(view);
-    std::transform(lowered.begin(), lowered.end(), lowered.begin(), ::tolower);
-    if (lowered == ".nan" || lowered == "nan" || lowered == ".inf" || lowered == "inf" || lowered == "-.inf" ||
-        lowered == "-inf" || lowered == "infinity" || lowered == "-infinity")
-        ctx.fail(node, what + ": must be a finite number, got '" + text + "'");
+    if (view.size() <= 9 && !view.empty() && !std::isdigit(static_cast<unsigned char>(view.back()))) {
+        std::string lowered(view);
+        std::transform(lowered.begin(), lowered.end(), lowered.begin(), ::tolower);
+        if (lowered == ".nan" || lowered == "nan" || lowered == ".inf" || lowered == "inf" || lowered == "-.inf" ||
+            lowered == "-inf" || lowered == "infinity" || lowered == "-infinity")
+            ctx.fail(node, what + ": must be a finite number, got '" + text() + "'");
+    }
     double value = 0;
     const auto [end, error] = std::from_chars(view.data(), view.data() + view.size(), value);
-    if (error == std::errc::result_out_of_range) ctx.fail(node, what + ": number '" + text + "' is out of range");
+    if (error == std::errc::result_out_of_range) ctx.fail(node, what + ": number '" + text() + "' is out of range");
     if (error != std::errc() || end != view.data() + view.size())
         ctx.fail(node, what + ": expected a number, got " + describe(node));
-    if (!std::isfinite(value)) ctx.fail(node, what + ": must be a finite number, got '" + text + "'");
+    if (!std::isfinite(value)) ctx.fail(node, what + ": must be a finite number, got '" + text() + "'");
     return value;
 }
 
-int64_t parse_integer(const ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+int64_t parse_integer(const ParseContext& ctx, const Node& node, const std::string& what) {
     const double value = parse_number(ctx, node, what);
     if (value != std::floor(value) || std::fabs(value) > 9.0e15)
         ctx.fail(node, what + ": expected a whole number, got " + describe(node));
     return static_cast<int64_t>(value);
 }
 
-Vec3 parse_vec3(const ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+Vec3 parse_vec3(const ParseContext& ctx, const Node& node, const std::string& what) {
     if (!node.IsSequence()) ctx.fail(node, what + ": expected a list of 3 numbers [x, y, z], got " + describe(node));
     if (node.size() != 3) ctx.fail(node, what + ": expected 3 numbers, got a list of " + std::to_string(node.size()));
     return {parse_number(ctx, node[0], what), parse_number(ctx, node[1], what), parse_number(ctx, node[2], what)};
 }
 
 /// A colour: [r, g, b], or one number c meaning [c, c, c].
-Color parse_color(const ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+Color parse_color(const ParseContext& ctx, const Node& node, const std::string& what) {
     if (node.IsScalar()) return Color(parse_number(ctx, node, what));
     if (!node.IsSequence()) ctx.fail(node, what + ": expected a colour [r, g, b] or a number, got " + describe(node));
     return parse_vec3(ctx, node, what);
 }
 
-std::string parse_string(const ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+std::string parse_string(const ParseContext& ctx, const Node& node, const std::string& what) {
     if (!node.IsScalar()) ctx.fail(node, what + ": expected a name, got " + describe(node));
     return node.Scalar();
 }
@@ -135,28 +139,29 @@ std::string join(const std::vector<std::string>& words) {
 /// Reads one YAML map: rejects unknown keys (with a suggestion) and finds values by key.
 class MapReader {
 public:
-    MapReader(ParseContext& ctx, const YAML::Node& node, std::string what, std::vector<std::string> allowed)
+    MapReader(ParseContext& ctx, const Node& node, std::string what, std::vector<std::string> allowed)
         : m_ctx(ctx), m_node(node), m_what(std::move(what)), m_allowed(std::move(allowed)) {
         if (!node.IsMap()) ctx.fail(node, m_what + ": expected a map of keys, got " + describe(node));
-        for (const auto& entry : node) {
-            const YAML::Node& key = entry.first;
+        m_keys.reserve(node.size());
+        for (const auto& entry : node.pairs()) {
+            const Node& key = entry.first;
             if (!key.IsScalar()) ctx.fail(key, m_what + ": keys must be plain names");
             const std::string name = key.Scalar();
             if (std::find(m_allowed.begin(), m_allowed.end(), name) == m_allowed.end())
-                ctx.fail(key, m_what + ": unknown key '" + name + "'" + did_you_mean(name, m_allowed) +
+                ctx.fail(key, m_what + ": unknown key '" + printable(name) + "'" + did_you_mean(name, m_allowed) +
                                   "; expected one of: " + join(m_allowed));
             for (const auto& seen : m_keys)
-                if (seen == name) ctx.fail(key, m_what + ": key '" + name + "' is given twice");
+                if (seen == name) ctx.fail(key, m_what + ": key '" + printable(name) + "' is given twice");
             m_keys.push_back(name);
         }
     }
 
     bool has(const std::string& key) const { return std::find(m_keys.begin(), m_keys.end(), key) != m_keys.end(); }
-    YAML::Node get(const std::string& key) const { return m_node[key]; }
+    Node get(const std::string& key) const { return m_node[key]; }
     SourceLocation where() const { return m_ctx.at(m_node); }
     std::string what(const std::string& key) const { return m_what + "." + key; }
 
-    YAML::Node require(const std::string& key) const {
+    Node require(const std::string& key) const {
         if (!has(key)) m_ctx.fail(m_node, m_what + ": missing required key '" + key + "'");
         return get(key);
     }
@@ -168,7 +173,7 @@ public:
             out.where = where();
             return;
         }
-        const YAML::Node value = get(key);
+        const Node value = get(key);
         out.value = parse(m_ctx, value, what(key));
         out.where = m_ctx.at(value);
         out.given = true;
@@ -188,7 +193,7 @@ public:
 
 private:
     ParseContext& m_ctx;
-    YAML::Node m_node;
+    Node m_node;
     std::string m_what;
     std::vector<std::string> m_allowed;
     std::vector<std::string> m_keys;
@@ -196,35 +201,15 @@ private:
 
 /// Picks one of a fixed set of words, e.g. a camera type.
 template <class Enum>
-Enum parse_choice(const ParseContext& ctx, const YAML::Node& node, const std::string& what,
+Enum parse_choice(const ParseContext& ctx, const Node& node, const std::string& what,
                   const std::vector<std::pair<std::string, Enum>>& choices) {
     const std::string word = parse_string(ctx, node, what);
-    std::vector<std::string> names;
-    for (const auto& [name, value] : choices) {
+    for (const auto& [name, value] : choices)
         if (name == word) return value;
-        names.push_back(name);
-    }
-    ctx.fail(node,
-             what + ": unknown value '" + word + "'" + did_you_mean(word, names) + "; expected one of: " + join(names));
-}
-
-/// Counts every node reachable from `node`, following aliases, and refuses documents past
-/// limits::max_yaml_nodes: a few lines of nested aliases can expand to billions of nodes.
-void count_nodes(ParseContext& ctx, const YAML::Node& node, int depth) {
-    if (++ctx.nodes_seen > limits::max_yaml_nodes)
-        ctx.fail(node, "the document expands to more than " + std::to_string(limits::max_yaml_nodes) +
-                           " values (nested aliases?); refusing to read it");
-    if (depth > 512) ctx.fail(node, "values nested more than 512 levels deep");
-    if (node.IsSequence() || node.IsMap()) {
-        for (const auto& child : node) {
-            if (node.IsMap()) {
-                count_nodes(ctx, child.first, depth + 1);
-                count_nodes(ctx, child.second, depth + 1);
-            } else {
-                count_nodes(ctx, child, depth + 1);
-            }
-        }
-    }
+    std::vector<std::string> names;
+    for (const auto& choice : choices) names.push_back(choice.first);
+    ctx.fail(node, what + ": unknown value '" + printable(word) + "'" + did_you_mean(word, names) +
+                       "; expected one of: " + join(names));
 }
 
 /// The image-plane window keys (the Cornell course's camera); a perspective camera with
@@ -236,13 +221,13 @@ void parse_camera_window(const MapReader& map, CameraDescription& camera) {
     if (camera.type.value == CameraType::perspective && camera.view_height.given) map.require("view_width");
 }
 
-CameraDescription parse_camera(ParseContext& ctx, const YAML::Node& node) {
+CameraDescription parse_camera(ParseContext& ctx, const Node& node) {
     MapReader map(ctx, node, "camera",
                   {"type", "eye", "look_at", "up", "fov", "view_width", "view_height", "projection_distance",
                    "image_plane_normal"});
     CameraDescription camera;
     camera.where = map.where();
-    map.read(camera.type, "type", [](const ParseContext& c, const YAML::Node& n, const std::string& w) {
+    map.read(camera.type, "type", [](const ParseContext& c, const Node& n, const std::string& w) {
         return parse_choice<CameraType>(
             c, n, w, {{"perspective", CameraType::perspective}, {"orthographic", CameraType::orthographic}});
     });
@@ -255,7 +240,7 @@ CameraDescription parse_camera(ParseContext& ctx, const YAML::Node& node) {
     return camera;
 }
 
-ImageDescription parse_image(ParseContext& ctx, const YAML::Node& node) {
+ImageDescription parse_image(ParseContext& ctx, const Node& node) {
     MapReader map(ctx, node, "image", {"width", "height", "background", "samples"});
     ImageDescription image;
     image.where = map.where();
@@ -266,9 +251,9 @@ ImageDescription parse_image(ParseContext& ctx, const YAML::Node& node) {
     return image;
 }
 
-LightDescription parse_light(ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+LightDescription parse_light(ParseContext& ctx, const Node& node, const std::string& what) {
     if (!node.IsMap()) ctx.fail(node, what + ": expected a map with 'type', got " + describe(node));
-    const YAML::Node type_node = node["type"];
+    const Node type_node = node["type"];
     if (!type_node) ctx.fail(node, what + ": missing required key 'type' (point or directional)");
     LightDescription light;
     light.type = parse_choice<LightType>(ctx, type_node, what + ".type",
@@ -287,7 +272,7 @@ LightDescription parse_light(ParseContext& ctx, const YAML::Node& node, const st
     return light;
 }
 
-MaterialDescription parse_material(ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+MaterialDescription parse_material(ParseContext& ctx, const Node& node, const std::string& what) {
     MapReader map(ctx, node, what, {"ka", "kd", "ks", "p", "km", "highlight", "fresnel_ior"});
     MaterialDescription material;
     material.where = map.where();
@@ -296,7 +281,7 @@ MaterialDescription parse_material(ParseContext& ctx, const YAML::Node& node, co
     map.color(material.ks, "ks");
     map.number(material.p, "p");
     map.color(material.km, "km");
-    map.read(material.highlight, "highlight", [](const ParseContext& c, const YAML::Node& n, const std::string& w) {
+    map.read(material.highlight, "highlight", [](const ParseContext& c, const Node& n, const std::string& w) {
         return parse_choice<Highlight>(c, n, w, {{"blinn", Highlight::blinn}, {"phong", Highlight::phong}});
     });
     map.number(material.fresnel_ior, "fresnel_ior");
@@ -306,10 +291,10 @@ MaterialDescription parse_material(ParseContext& ctx, const YAML::Node& node, co
     return material;
 }
 
-MaterialReference parse_material_reference(ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+MaterialReference parse_material_reference(ParseContext& ctx, const Node& node, const std::string& what) {
     MaterialReference reference;
     reference.where = ctx.at(node);
-    if (node.IsScalar() && node.Tag() != "!" && node.Scalar().empty())
+    if (node.IsScalar() && !node.IsQuoted() && node.Scalar().empty())
         ctx.fail(node, what + ": expected a material name or an inline material map");
     if (node.IsScalar()) {
         reference.name = node.Scalar();
@@ -321,8 +306,8 @@ MaterialReference parse_material_reference(ParseContext& ctx, const YAML::Node& 
     return reference;
 }
 
-std::vector<TransformStep> parse_transform(ParseContext& ctx, const YAML::Node& node, const std::string& what) {
-    const auto parse_step = [&](const YAML::Node& step_node, const std::string& step_what) {
+std::vector<TransformStep> parse_transform(ParseContext& ctx, const Node& node, const std::string& what) {
+    const auto parse_step = [&](const Node& step_node, const std::string& step_what) {
         MapReader map(ctx, step_node, step_what, {"scale", "rotate", "translate", "matrix"});
         int count = map.has("scale") + map.has("rotate") + map.has("translate") + map.has("matrix");
         if (count != 1)
@@ -330,13 +315,13 @@ std::vector<TransformStep> parse_transform(ParseContext& ctx, const YAML::Node& 
         TransformStep step;
         step.where = map.where();
         if (map.has("scale")) {
-            const YAML::Node value = map.get("scale");
+            const Node value = map.get("scale");
             step.kind = TransformStep::Kind::scale;
             step.where = ctx.at(value);
             step.vector = value.IsScalar() ? Vec3(parse_number(ctx, value, step_what + ".scale"))
                                            : parse_vec3(ctx, value, step_what + ".scale");
         } else if (map.has("translate")) {
-            const YAML::Node value = map.get("translate");
+            const Node value = map.get("translate");
             step.kind = TransformStep::Kind::translate;
             step.where = ctx.at(value);
             step.vector = parse_vec3(ctx, value, step_what + ".translate");
@@ -347,7 +332,7 @@ std::vector<TransformStep> parse_transform(ParseContext& ctx, const YAML::Node& 
             step.vector = parse_vec3(ctx, rotate.require("axis"), step_what + ".rotate.axis");
             step.angle = parse_number(ctx, rotate.require("angle"), step_what + ".rotate.angle");
         } else {
-            const YAML::Node value = map.get("matrix");
+            const Node value = map.get("matrix");
             step.kind = TransformStep::Kind::matrix;
             step.where = ctx.at(value);
             if (!value.IsSequence() || value.size() != 16)
@@ -373,7 +358,7 @@ std::vector<TransformStep> parse_transform(ParseContext& ctx, const YAML::Node& 
     return steps;
 }
 
-std::vector<Vec3> parse_vec3_list(ParseContext& ctx, const YAML::Node& node, const std::string& what) {
+std::vector<Vec3> parse_vec3_list(ParseContext& ctx, const Node& node, const std::string& what) {
     if (!node.IsSequence()) ctx.fail(node, what + ": expected a list of [x, y, z], got " + describe(node));
     std::vector<Vec3> out;
     out.reserve(node.size());
@@ -382,11 +367,15 @@ std::vector<Vec3> parse_vec3_list(ParseContext& ctx, const YAML::Node& node, con
     return out;
 }
 
-ObjectDescription parse_object(ParseContext& ctx, const YAML::Node& node, const std::string& what, int depth);
+ObjectDescription parse_object(ParseContext& ctx, const Node& node, const std::string& what, int depth);
 
-std::vector<ObjectDescription> parse_objects(ParseContext& ctx, const YAML::Node& node, const std::string& what,
-                                             int depth) {
+std::vector<ObjectDescription> parse_objects(ParseContext& ctx, const Node& node, const std::string& what, int depth) {
     if (node.IsNull()) return {};
+    if (node.IsStreamed()) {  // the top-level list, parsed while it was read
+        if (ctx.objects_error) std::rethrow_exception(ctx.objects_error);
+        if (ctx.objects.size() < ctx.objects.capacity() / 2) ctx.objects.shrink_to_fit();
+        return std::move(ctx.objects);
+    }
     if (!node.IsSequence()) ctx.fail(node, what + ": expected a list of objects, got " + describe(node));
     std::vector<ObjectDescription> objects;
     for (size_t i = 0; i < node.size(); ++i)
@@ -394,19 +383,16 @@ std::vector<ObjectDescription> parse_objects(ParseContext& ctx, const YAML::Node
     return objects;
 }
 
-ObjectDescription parse_object(ParseContext& ctx, const YAML::Node& node, const std::string& what, int depth) {
+ObjectDescription parse_object(ParseContext& ctx, const Node& node, const std::string& what, int depth) {
     if (!node.IsMap()) ctx.fail(node, what + ": expected a map with 'type', got " + describe(node));
-    const YAML::Node type_node = node["type"];
+    const Node type_node = node["type"];
     if (!type_node)
         ctx.fail(node, what + ": missing required key 'type' (sphere, plane, box, triangle, mesh or group)");
     ObjectDescription object;
-    object.type = parse_choice<ObjectType>(ctx, type_node, what + ".type",
-                                           {{"sphere", ObjectType::sphere},
-                                            {"plane", ObjectType::plane},
-                                            {"box", ObjectType::box},
-                                            {"triangle", ObjectType::triangle},
-                                            {"mesh", ObjectType::mesh},
-                                            {"group", ObjectType::group}});
+    static const std::vector<std::pair<std::string, ObjectType>> object_types = {
+        {"sphere", ObjectType::sphere},     {"plane", ObjectType::plane}, {"box", ObjectType::box},
+        {"triangle", ObjectType::triangle}, {"mesh", ObjectType::mesh},   {"group", ObjectType::group}};
+    object.type = parse_choice<ObjectType>(ctx, type_node, what + ".type", object_types);
     const std::string label = what + " (" + to_string(object.type) + ")";
     std::vector<std::string> keys{"type", "transform"};
     if (object.type != ObjectType::group) keys.push_back("material");
@@ -449,7 +435,7 @@ ObjectDescription parse_object(ParseContext& ctx, const YAML::Node& node, const 
             map.vec3(object.max, "max", true);
             break;
         case ObjectType::triangle: {
-            const YAML::Node vertices = map.require("vertices");
+            const Node vertices = map.require("vertices");
             object.vertices_where = ctx.at(vertices);
             object.vertices = parse_vec3_list(ctx, vertices, label + ".vertices");
             if (object.vertices.size() != 3)
@@ -472,15 +458,15 @@ ObjectDescription parse_object(ParseContext& ctx, const YAML::Node& node, const 
             }
             if (!map.has("vertices") && !map.has("triangles"))
                 ctx.fail(node, label + ": a mesh needs 'file', or inline 'vertices' and 'triangles'");
-            const YAML::Node vertices = map.require("vertices");
+            const Node vertices = map.require("vertices");
             object.vertices_where = ctx.at(vertices);
             object.vertices = parse_vec3_list(ctx, vertices, label + ".vertices");
-            const YAML::Node triangles = map.require("triangles");
+            const Node triangles = map.require("triangles");
             object.triangles_where = ctx.at(triangles);
             if (!triangles.IsSequence())
                 ctx.fail(triangles, label + ".triangles: expected a list of [i, j, k], got " + describe(triangles));
             for (size_t i = 0; i < triangles.size(); ++i) {
-                const YAML::Node triangle = triangles[i];
+                const Node triangle = triangles[i];
                 const std::string item = label + ".triangles[" + std::to_string(i) + "]";
                 if (!triangle.IsSequence() || triangle.size() != 3)
                     ctx.fail(triangle, item + ": expected 3 vertex indices [i, j, k], got " +
@@ -492,7 +478,7 @@ ObjectDescription parse_object(ParseContext& ctx, const YAML::Node& node, const 
                 object.triangle_where.push_back(ctx.at(triangle));
             }
             if (map.has("normals")) {
-                const YAML::Node normals = map.get("normals");
+                const Node normals = map.get("normals");
                 object.normals_where = ctx.at(normals);
                 object.normals = parse_vec3_list(ctx, normals, label + ".normals");
             }
@@ -502,7 +488,7 @@ ObjectDescription parse_object(ParseContext& ctx, const YAML::Node& node, const 
             if (depth + 1 > limits::max_nesting)
                 ctx.fail(node,
                          label + ": groups nested deeper than " + std::to_string(limits::max_nesting) + " levels");
-            const YAML::Node children = map.require("objects");
+            const Node children = map.require("objects");
             object.children = parse_objects(ctx, children, label + ".objects", depth + 1);
             break;
         }
@@ -511,7 +497,7 @@ ObjectDescription parse_object(ParseContext& ctx, const YAML::Node& node, const 
 }
 
 /// render.layers: a list of layer names (checked against the known layers in validation).
-std::vector<Located<std::string>> parse_render_layers(ParseContext& ctx, const YAML::Node& node) {
+std::vector<Located<std::string>> parse_render_layers(ParseContext& ctx, const Node& node) {
     if (!node.IsSequence()) ctx.fail(node, "render.layers: expected a list of layer names, got " + describe(node));
     std::vector<Located<std::string>> layers;
     for (size_t i = 0; i < node.size(); ++i) {
@@ -526,16 +512,15 @@ std::vector<Located<std::string>> parse_render_layers(ParseContext& ctx, const Y
 /// `render.convention` and `render.min_weight`: the Cornell course's shading rules, kept out of
 /// the default (POV-Ray's) path.
 void parse_render_conventions(const MapReader& render, SceneDescription& scene) {
-    render.read(scene.convention, "convention", [](const ParseContext& c, const YAML::Node& n, const std::string& w) {
+    render.read(scene.convention, "convention", [](const ParseContext& c, const Node& n, const std::string& w) {
         return parse_choice<Convention>(c, n, w, {{"pov", Convention::pov}, {"course", Convention::course}});
     });
     render.number(scene.min_weight, "min_weight");
 }
 
-SceneDescription parse_document(ParseContext& ctx, const YAML::Node& root) {
+SceneDescription parse_document(ParseContext& ctx, const Node& root) {
     if (!root || root.IsNull())
         throw InputError({ctx.file, 1, 1}, "the scene is empty: expected a map with 'camera', 'image' and 'objects'");
-    count_nodes(ctx, root, 0);
     MapReader map(ctx, root, "scene",
                   {"version", "camera", "image", "render", "ambient", "lights", "materials", "objects"});
     SceneDescription scene;
@@ -557,7 +542,7 @@ SceneDescription parse_document(ParseContext& ctx, const YAML::Node& root) {
     }
     map.color(scene.ambient, "ambient");
     if (map.has("lights")) {
-        const YAML::Node lights = map.get("lights");
+        const Node lights = map.get("lights");
         if (!lights.IsNull()) {
             if (!lights.IsSequence()) ctx.fail(lights, "lights: expected a list of lights, got " + describe(lights));
             for (size_t i = 0; i < lights.size(); ++i)
@@ -565,15 +550,16 @@ SceneDescription parse_document(ParseContext& ctx, const YAML::Node& root) {
         }
     }
     if (map.has("materials")) {
-        const YAML::Node materials = map.get("materials");
+        const Node materials = map.get("materials");
         if (!materials.IsNull()) {
             if (!materials.IsMap())
                 ctx.fail(materials, "materials: expected a map of name: material, got " + describe(materials));
-            for (const auto& entry : materials) {
+            for (const auto& entry : materials.pairs()) {
                 if (!entry.first.IsScalar() || entry.first.Scalar().empty())
                     ctx.fail(entry.first, "materials: names must be plain, non-empty words");
                 const std::string name = entry.first.Scalar();
-                if (scene.find_material(name)) ctx.fail(entry.first, "materials: '" + name + "' is defined twice");
+                if (scene.find_material(name))
+                    ctx.fail(entry.first, "materials: '" + printable(name) + "' is defined twice");
                 MaterialDescription material = parse_material(ctx, entry.second, "materials." + name);
                 material.name = name;
                 scene.materials.push_back(std::move(material));
@@ -610,46 +596,43 @@ const char* to_string(ObjectType type) {
     return "object";
 }
 
-/// yaml-cpp's messages are terse; say what usually causes them.
-static std::string syntax_hint(const std::string& text, int line) {
-    size_t begin = 0;
-    for (int l = 0; l < line && begin != std::string::npos; ++l) {
-        begin = text.find('\n', begin);
-        if (begin != std::string::npos) ++begin;
-    }
-    for (size_t i = begin; i != std::string::npos && i < text.size() && (text[i] == ' ' || text[i] == '\t'); ++i)
-        if (text[i] == '\t') return " (a tab in the indentation: YAML indents with spaces only)";
-    if (text.find("[[[[[[[[[[") != std::string::npos || text.find("{{{{{{{{{{") != std::string::npos)
-        return " (values nested too deeply)";
-    return "";
-}
-
-SceneDescription parse_scene_text(const std::string& text, const std::string& path) {
+SceneDescription parse_scene_text(std::string_view text, const std::string& path) {
     ParseContext ctx;
     ctx.file = path;
     ctx.directory = std::filesystem::path(path).parent_path().string();
     check_text_is_readable(text, path);
-    YAML::Node root;
+    yaml_tree::Document document;
+    // Room for as many objects as a file of one-line objects holds (a sphere takes 64 bytes of
+    // text at least): moving hundreds of thousands of descriptions each time the list grows cost
+    // more than reading them. Pages never written are never resident; what is left is given back.
     try {
-        root = YAML::Load(text);
-    } catch (const YAML::ParserException& e) {
-        throw InputError({path, e.mark.line + 1, e.mark.column + 1},
-                         "syntax error: " + e.msg + syntax_hint(text, e.mark.line));
-    } catch (const YAML::Exception& e) {
-        throw InputError({path, e.mark.is_null() ? 0 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1},
-                         std::string("cannot read the scene: ") + e.msg);
+        ctx.objects.reserve(std::min<size_t>(text.size() / 64, size_t(1) << 24));
+    } catch (const std::bad_alloc&) {  // a machine without overcommit: grow as needed
     }
-    try {
-        return parse_document(ctx, root);
-    } catch (const YAML::Exception& e) {  // e.g. a bad conversion deep inside yaml-cpp
-        throw InputError({path, e.mark.is_null() ? 0 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1},
-                         std::string("cannot read the scene: ") + e.msg);
-    }
+    // Each top-level object is parsed as soon as it is read; its first mistake is kept and
+    // reported when parse_document reaches `objects`, so that mistakes are reported in the
+    // order the keys are checked, as for the rest of the scene.
+    const auto on_object = [&ctx](const Node& item, size_t index) {
+        if (index == 0) ctx.objects.clear(), ctx.objects_error = nullptr;  // read again by libyaml
+        if (ctx.objects_error) return;
+        try {
+            ctx.objects.push_back(parse_object(ctx, item, "objects[" + std::to_string(index) + "]", 0));
+        } catch (const InputError&) {
+            ctx.objects_error = std::current_exception();
+        }
+    };
+    yaml_tree::Limits tree_limits;
+    tree_limits.max_nodes_at_once = tree_limits.max_alias_values = uint64_t(limits::max_yaml_nodes);
+    document.read(text, ctx.file, on_object, tree_limits);
+    return parse_document(ctx, document.root());
 }
 
 SceneDescription parse_scene_file(const std::string& path) {
     if (is_course_xml_path(path)) return parse_course_xml_file(path);  // the Cornell course's XML scenes
-    return parse_scene_text(read_text_file(path, limits::max_scene_file_bytes, "scene file"), path);
+    // Mapped, not copied; devices, fifos and other files that are not regular files are refused
+    // before a byte is read (/dev/urandom would never end).
+    const MappedTextFile file(path, limits::max_scene_file_bytes, "scene file");
+    return parse_scene_text(file.text(), path);
 }
 
 }  // namespace whitted

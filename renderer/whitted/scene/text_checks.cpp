@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
@@ -85,12 +86,39 @@ void check_text_is_readable(std::string_view text, const std::string& path) {
         for (size_t k = 1; k <= extra; ++k)
             if ((bytes[i + k] & 0xC0) != 0x80)
                 throw InputError({path, line, column}, "the file is not valid UTF-8 text");
+        // Overlong forms and UTF-16 surrogates (ED A0..BF ..) are not characters either.
+        if (extra >= 2) {
+            const unsigned char second = bytes[i + 1];
+            if ((c == 0xE0 && second < 0xA0) || (c == 0xED && second > 0x9F) || (c == 0xF0 && second < 0x90) ||
+                (c == 0xF4 && second > 0x8F))
+                throw InputError({path, line, column}, "the file is not valid UTF-8 text");
+        }
         if (c == '\n')
             line += 1, column = 1;
         else
             column += 1;
         i += extra + 1;
     }
+}
+
+std::string printable(std::string_view text, size_t max_characters) {
+    static constexpr char hex[] = "0123456789abcdef";
+    std::string out;
+    size_t characters = 0, i = 0;
+    for (; i < text.size() && characters < max_characters; ++characters) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c < 0x20 || c == 0x7F) {
+            out += c == '\n' ? "\\n" : c == '\t' ? "\\t" : std::string{'\\', 'x', hex[c >> 4], hex[c & 15]};
+            ++i;
+            continue;
+        }
+        size_t length = c < 0x80 ? 1 : c >= 0xF0 ? 4 : c >= 0xE0 ? 3 : 2;  // one UTF-8 character
+        length = std::min(length, text.size() - i);
+        out.append(text.substr(i, length));
+        i += length;
+    }
+    if (i < text.size()) out += "... (" + std::to_string(text.size()) + " bytes)";
+    return out;
 }
 
 MappedTextFile::MappedTextFile(const std::string& path, int64_t max_bytes, const std::string& what) {

@@ -35,6 +35,11 @@ private:
     size_t m_length = 0;
 };
 
+/// `text` made safe to print in a message: control characters (ESC, BEL, ...) written as \xNN
+/// escapes, so a scene cannot drive the terminal, and at most `max_characters` characters, the
+/// rest replaced by "... (N bytes)". `text` must be valid UTF-8 (as a checked scene is).
+std::string printable(std::string_view text, size_t max_characters = 60);
+
 /// " (did you mean 'x'?)" for the closest candidate within a small edit distance, else "".
 std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates);
 

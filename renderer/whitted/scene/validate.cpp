@@ -80,7 +80,7 @@ private:
         if (it == m_material_index.end()) {
             std::string known;
             for (const auto& name : m_material_names) known += (known.empty() ? "" : ", ") + name;
-            fail(reference.where, kind + ": unknown material '" + reference.name + "'" +
+            fail(reference.where, kind + ": unknown material '" + printable(reference.name) + "'" +
                                       did_you_mean(reference.name, m_material_names) +
                                       (known.empty() ? "; the scene defines no materials" : "; defined: " + known));
         }

@@ -1,0 +1,239 @@
+// SPDX-License-Identifier: MIT
+// The scene file's value tree (yaml_tree.h): the fast scanner must read exactly what libyaml
+// reads (every YAML and JSON file in the repository, and hand-written forms), the limits hold
+// while reading, and the top-level objects are handed on and forgotten one by one.
+
+#include "whitted/scene/yaml_tree.h"
+#include "whitted/scene/description.h"
+#include "whitted/scene/text_checks.h"
+
+#include "test_support.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace whitted::yaml_tree {
+namespace {
+
+using ::testing::HasSubstr;
+
+/// The tree as text: kind, line:column, quotedness and value of every node, in order.
+void dump(const Node& node, std::string& out, int depth = 0) {
+    out += std::string(size_t(depth) * 2, ' ');
+    const SourceLocation at = node.location();
+    out += std::to_string(at.line) + ":" + std::to_string(at.column) + " ";
+    switch (node.kind()) {
+        case Kind::undefined:
+            out += "undefined\n";
+            return;
+        case Kind::null:
+            out += "null\n";
+            return;
+        case Kind::scalar:
+            out += (node.IsQuoted() ? "quoted '" : "plain '") + node.Scalar() + "'\n";
+            return;
+        case Kind::sequence:
+            out += node.IsStreamed() ? "streamed list\n" : "list\n";
+            for (size_t i = 0; i < node.size(); ++i) dump(node[i], out, depth + 1);
+            return;
+        case Kind::map:
+            out += "map\n";
+            for (const Pair& pair : node.pairs()) {
+                dump(pair.first, out, depth + 1);
+                dump(pair.second, out, depth + 2);
+            }
+            return;
+    }
+}
+
+/// Reads `text` with one reader; the dump of the tree and of every streamed object, or the
+/// error message.
+std::string read_with(const std::string& text, Reader reader) {
+    Document document;
+    std::string objects;
+    const auto on_object = [&](const Node& item, size_t index) {
+        objects += "object " + std::to_string(index) + "\n";
+        dump(item, objects, 1);
+    };
+    try {
+        document.read(text, "test.yaml", on_object, {}, &reader);
+    } catch (const InputError& e) {
+        return std::string("error: ") + e.what();
+    }
+    std::string out;
+    dump(document.root(), out);
+    return out + objects;
+}
+
+TEST(YamlTree, FastScannerReadsWhatLibyamlReadsInEveryRepositoryScene) {
+    int fast = 0, left_to_libyaml = 0;
+    for (const char* dir : {"examples", "tests", "bench", "docs"}) {
+        const std::filesystem::path root = std::filesystem::path(WHITTED_SOURCE_DIR) / dir;
+        if (!std::filesystem::exists(root)) continue;
+        for (const auto& entry : std::filesystem::recursive_directory_iterator(root)) {
+            const std::string ext = entry.path().extension().string();
+            if (!entry.is_regular_file() || (ext != ".yaml" && ext != ".json")) continue;
+            std::ifstream in(entry.path(), std::ios::binary);
+            std::stringstream buffer;
+            buffer << in.rdbuf();
+            const std::string text = buffer.str();
+            try {
+                check_text_is_readable(text, "test.yaml");
+            } catch (const InputError&) {
+                continue;  // refused before either reader sees it
+            }
+            std::string fast_tree;
+            try {
+                fast_tree = read_with(text, Reader::fast);
+            } catch (const NotForTheFastScanner&) {
+                ++left_to_libyaml;
+                continue;
+            }
+            ++fast;
+            EXPECT_EQ(fast_tree, read_with(text, Reader::libyaml)) << entry.path();
+        }
+    }
+    RecordProperty("fast", fast);
+    RecordProperty("libyaml", left_to_libyaml);
+    // Most scenes are plain YAML or JSON: the fast scanner must be the one that reads them.
+    EXPECT_GT(fast, 150);
+    EXPECT_GT(fast, 3 * left_to_libyaml);
+}
+
+TEST(YamlTree, FastScannerReadsTheUsualFormsLikeLibyaml) {
+    const std::vector<std::string> texts = {
+        "a: 1\nb: [1, 2.5, -3e-2]\nc: {x: y, 'q': \"z w\"}\n",
+        "# comment\n\nkey:   # after a key\n  - one\n  - two  # after a value\nother: ~\n",
+        "list:\n- a\n- b\nnext: null\n",
+        "outer:\n  inner:\n    deep: [[1, 2], [3], []]\n  empty: {}\nlast:\n",
+        "- - a\n  - b\n- key: v\n  key2: w\n-\n- {}\n",
+        "{\"camera\": {\"eye\": [0, 6, 14], \"fov\": 60},\n \"objects\": [\n  {\"type\": \"sphere\"},\n  {\"type\": "
+        "\"box\"}\n]}\n",
+        "objects:\n  - {type: sphere, center: [0, 0, 0]}\n  - type: group\n    objects:\n      - {type: box}\n",
+        "name with spaces: a b c\npath: models/x.obj\nnum: +1.5\ndot: .5\nnulls: [~, null, Null, NULL]\n",
+        "quoted: ''\nq2: \"\"\nplainnull:\n",
+    };
+    for (const std::string& text : texts) {
+        std::string fast_tree;
+        ASSERT_NO_THROW(fast_tree = read_with(text, Reader::fast)) << text;
+        EXPECT_EQ(fast_tree, read_with(text, Reader::libyaml)) << text;
+    }
+}
+
+TEST(YamlTree, WhatTheFastScannerDoesNotReadGoesToLibyaml) {
+    const std::vector<std::string> texts = {
+        "a: &x [1, 2]\nb: *x\n", "a: !!str 1\n", "a: |\n  block\n", "a: \"esc\\tape\"\n",
+        "a: multi\n  line\n",    "---\na: 1\n",  "a:\tb\n",         "{\"a\":1}",
+        "a: [1,\n  2]\n",        "a: x:y\n",     "a: 'it''s'\n",    "a: caf\xc3\xa9\n",
+    };
+    for (const std::string& text : texts) {
+        EXPECT_THROW(read_with(text, Reader::fast), NotForTheFastScanner) << text;
+        Document document;
+        document.read(text, "test.yaml");  // the default: the scanner, then libyaml
+        EXPECT_EQ(document.reader(), Reader::libyaml) << text;
+        EXPECT_TRUE(document.root().IsMap()) << text;
+    }
+}
+
+TEST(YamlTree, StringTagAndQuotesMakeStrings) {
+    Document document;
+    document.read("a: !!str 1\nb: '2'\nc: 3\nd: ! 4\n", "test.yaml");
+    EXPECT_TRUE(document.root()["a"].IsQuoted());
+    EXPECT_TRUE(document.root()["b"].IsQuoted());
+    EXPECT_FALSE(document.root()["c"].IsQuoted());
+    EXPECT_TRUE(document.root()["d"].IsQuoted());
+    EXPECT_EQ(document.root()["a"].Scalar(), "1");
+}
+
+TEST(YamlTree, ASecondDocumentIsAnError) {
+    for (const char* text : {"a: 1\n---\nb: 2\n", "a: 1\n...\n---\nb: 2\n", "--- {a: 1}\n--- {b: 2}\n"}) {
+        Document document;
+        try {
+            document.read(text, "test.yaml");
+            ADD_FAILURE() << "accepted " << text;
+        } catch (const InputError& e) {
+            EXPECT_THAT(e.message(), HasSubstr("a second YAML document")) << text;
+            EXPECT_GT(e.where().line, 1) << text;
+        }
+    }
+}
+
+TEST(YamlTree, NestingIsLimitedWhileReading) {
+    for (const Reader reader : {Reader::fast, Reader::libyaml}) {
+        const std::string text = "a: " + std::string(600, '[') + std::string(600, ']') + "\n";
+        EXPECT_THAT(read_with(text, reader), HasSubstr("nested more than 512 levels deep"));
+    }
+}
+
+TEST(YamlTree, ValuesHeldAtOnceAreLimitedButStreamedObjectsAreForgotten) {
+    // 5000 objects of 7 values each with room for 1000 values at once: each object is handed on
+    // and forgotten before the next is read.
+    std::string text = "camera: {eye: [0, 0, 5]}\nobjects:\n";
+    for (int i = 0; i < 5000; ++i) text += "  - {type: sphere, center: [0, 0, " + std::to_string(i) + "]}\n";
+    Limits limits;
+    limits.max_nodes_at_once = 1000;
+    for (const Reader reader : {Reader::fast, Reader::libyaml}) {
+        Document document;
+        size_t objects = 0;
+        std::string last;
+        document.read(
+            text, "test.yaml",
+            [&](const Node& item, size_t) {
+                ++objects;
+                last = item["center"][2].Scalar();
+            },
+            limits, &reader);
+        EXPECT_EQ(objects, 5000u);
+        EXPECT_EQ(last, "4999");
+        EXPECT_TRUE(document.root()["objects"].IsStreamed());
+        EXPECT_EQ(document.root()["objects"].size(), 0u);
+        // Without streaming the same text passes the limit, with the line and column of the
+        // value that did.
+        try {
+            document.read(text, "test.yaml", {}, limits, &reader);
+            ADD_FAILURE() << "no limit";
+        } catch (const InputError& e) {
+            EXPECT_THAT(e.message(), HasSubstr("more than 1000 values at once"));
+            EXPECT_GT(e.where().line, 2);
+        }
+    }
+}
+
+TEST(YamlTree, AnAliasIsSharedNotCopied) {
+    Document document;
+    document.read("m: &m {kd: 0.5}\nobjects:\n  - {material: *m}\n  - {material: *m}\n", "test.yaml",
+                  [&](const Node& item, size_t) { EXPECT_EQ(item["material"]["kd"].Scalar(), "0.5"); });
+    EXPECT_EQ(document.root()["m"]["kd"].location().line, 1);
+}
+
+}  // namespace
+}  // namespace whitted::yaml_tree
+
+namespace whitted {
+namespace {
+
+TEST(ParseMessages, AHugeNameIsShortenedInTheMessage) {
+    const std::string name(10 << 20, 'x');
+    const auto error = test::scene_error(
+        "camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\nimage: {width: 8, height: 6}\n" + name + ": 1\n");
+    ASSERT_TRUE(error);
+    EXPECT_THAT(error->message(), ::testing::HasSubstr("unknown key 'xxxx"));
+    EXPECT_THAT(error->message(), ::testing::HasSubstr("(10485760 bytes)"));
+    EXPECT_LT(std::string(error->what()).size(), 400u);
+    EXPECT_EQ(error->where().line, 3);
+}
+
+TEST(ParseMessages, ControlCharactersInANameAreEscaped) {
+    const auto error = test::scene_error(
+        "camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\nimage: {width: 8, height: 6}\n\"\\e]0;x\\a\": 1\n");
+    ASSERT_TRUE(error);
+    EXPECT_THAT(error->message(), ::testing::HasSubstr("unknown key '\\x1b]0;x\\x07'"));
+    for (const char c : std::string(error->what())) EXPECT_GE(static_cast<unsigned char>(c), 0x20);
+}
+
+}  // namespace
+}  // namespace whitted
