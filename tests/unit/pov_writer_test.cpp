@@ -93,7 +93,8 @@ TEST(PovWriter, LightsAndObjectsShareOneLightGroup) {
 // POV-Ray's float plane distances stay small; centre + written vertex must be exactly the float
 // world vertex Whitted renders. A mesh near the origin is written as it is, with no translate.
 TEST(PovWriter, FarMeshWrittenAboutItsOwnCentreWithTheSameFloatVertices) {
-    const std::vector<Vec3> far{{100000.3, 70000.7, -40000.1}, {100001.9, 70000.2, -39999.5}, {99999.1, 70002.6, -40000.9}};
+    const std::vector<Vec3> far{
+        {100000.3, 70000.7, -40000.1}, {100001.9, 70000.2, -39999.5}, {99999.1, 70002.6, -40000.9}};
     std::string mesh = "objects:\n  - {type: mesh, material: {kd: 0.5}, triangles: [[0, 1, 2]], vertices: [";
     for (const Vec3& v : far) mesh += fmt_vec(v) + (&v == &far.back() ? "" : ", ");
     mesh += "]}\n";
@@ -114,7 +115,8 @@ TEST(PovWriter, FarMeshWrittenAboutItsOwnCentreWithTheSameFloatVertices) {
         "objects:\n  - {type: mesh, material: {kd: 0.5}, triangles: [[0, 1, 2]], "
         "vertices: [[0.3, 0.7, -0.1], [1.9, 0.2, 0.5], [-0.9, 2.6, -0.9]]}\n");
     EXPECT_THAT(near, Not(HasSubstr("translate")));
-    EXPECT_EQ(numbers_after(near, "vertex_vectors { 3,", 3), (std::vector<double>{float(0.3), float(0.7), float(-0.1)}));
+    EXPECT_EQ(numbers_after(near, "vertex_vectors { 3,", 3),
+              (std::vector<double>{float(0.3), float(0.7), float(-0.1)}));
 }
 
 // Awkward doubles (0.1 + 0.2, tiny, huge, many digits) come back bit for bit.

@@ -647,7 +647,8 @@ struct Accelerator::Impl {
             // planes alone answer, as if the triangles had been missed.
             if (!retry) return found;
             rejected = rayhit.ray.tfar;
-            if (attempt == max_refused_candidates) return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, 0, 0, 0, 0, {}, 0, {}, out, retry);
+            if (attempt == max_refused_candidates)
+                return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, 0, 0, 0, 0, {}, 0, {}, out, retry);
         }
     }
     static constexpr int max_refused_candidates = 8;
