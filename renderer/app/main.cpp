@@ -4,8 +4,8 @@
 // (0 ok, 1 failure while rendering or checking, 2 bad input or usage, 130/143 interrupted).
 
 #include "converters/pov_writer.h"
-#include "explain_command.h"
 #include "converters/yaml_writer.h"
+#include "explain_command.h"
 #include "reference/check.h"
 #include "whitted/output/atomic_files.h"
 #include "whitted/output/color_management.h"
@@ -312,33 +312,17 @@ int run_render(const RenderArguments& args) {
     }
 }
 
-/// `whitted convert SCENE out.yaml`: any scene Whitted reads (a course .xml file, say) in
-/// Whitted's own format, every value written out.
-int run_convert_to_yaml(const std::string& scene_path, const std::string& output) {
-    try {
-        const std::filesystem::path target(output);
-        const std::filesystem::path dir = target.parent_path().empty() ? "." : target.parent_path();
-        std::error_code error;
-        if (!std::filesystem::is_directory(dir, error))
-            throw std::invalid_argument("cannot write '" + output + "': directory '" + dir.string() +
-                                        "' does not exist");
-        if (std::filesystem::is_directory(target, error))
-            throw std::invalid_argument("cannot write '" + output + "': it is a directory");
-        const SceneDescription description = parse_scene_file(scene_path);
-        validate_scene(description);  // refuse what Whitted itself would refuse
-        yaml::write_yaml_file(description, output);
-        std::fprintf(stderr, "whitted: wrote %s\n", output.c_str());
-        return exit_ok;
-    } catch (const InputError& e) {
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::invalid_argument& e) {
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::exception& e) {
-        print_error(e.what());
-        return exit_failure;
-    }
+/// A usage error, before any work, when `target` cannot be written: its directory is missing or
+/// it is a directory itself. (The atomic writers refuse a directory in the way too, before they
+/// replace anything, for one that appears meanwhile.)
+void refuse_unwritable(const std::filesystem::path& target) {
+    const std::filesystem::path dir = target.parent_path().empty() ? "." : target.parent_path();
+    std::error_code error;
+    if (!std::filesystem::is_directory(dir, error))
+        throw std::invalid_argument("cannot write '" + target.string() + "': directory '" + dir.string() +
+                                    "' does not exist");
+    if (std::filesystem::is_directory(target, error))
+        throw std::invalid_argument("cannot write '" + target.string() + "': it is a directory");
 }
 
 int run_convert(const std::string& scene_path, const std::string& output) {
@@ -347,25 +331,23 @@ int run_convert(const std::string& scene_path, const std::string& output) {
     install_signal_handlers();
     try {
         const std::string ext = std::filesystem::path(output).extension().string();
-        if (ext == ".yaml" || ext == ".yml") return run_convert_to_yaml(scene_path, output);
-        if (ext != ".pov")
+        const bool to_yaml = ext == ".yaml" || ext == ".yml";
+        if (!to_yaml && ext != ".pov")
             throw std::invalid_argument("cannot convert to '" + output + "': unknown format '" + ext +
                                         "'; supported: .pov (POV-Ray 3.7), .yaml/.yml (Whitted's own format)");
-        // Usage errors before any work: where the two files cannot go. (write_pov_files refuses a
-        // directory in the way too, before it replaces anything, for one that appears meanwhile.)
+        // Usage errors before any work: where the file(s) cannot go.
         std::filesystem::path ini_path(output);
         ini_path.replace_extension(".ini");
-        for (const std::filesystem::path& target : {std::filesystem::path(output), ini_path}) {
-            const std::filesystem::path dir = target.parent_path().empty() ? "." : target.parent_path();
-            std::error_code error;
-            if (!std::filesystem::is_directory(dir, error))
-                throw std::invalid_argument("cannot write '" + target.string() + "': directory '" + dir.string() +
-                                            "' does not exist");
-            if (std::filesystem::is_directory(target, error))
-                throw std::invalid_argument("cannot write '" + target.string() + "': it is a directory");
-        }
+        refuse_unwritable(output);
+        if (!to_yaml) refuse_unwritable(ini_path);
         const SceneDescription description = parse_scene_file(scene_path);
         validate_scene(description);  // refuse what Whitted itself would refuse
+        if (to_yaml) {
+            // Any scene Whitted reads (a course .xml file, say) in Whitted's own format.
+            yaml::write_yaml_file(description, output);
+            std::fprintf(stderr, "whitted: wrote %s\n", output.c_str());
+            return exit_ok;
+        }
         const std::string ini = pov::write_pov_files(description, output);
         std::fprintf(stderr, "whitted: wrote %s and %s\n", output.c_str(), ini.c_str());
         return exit_ok;
