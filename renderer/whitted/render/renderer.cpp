@@ -40,16 +40,16 @@ Color render_pixel(const Scene& scene, const LectureShading& shading, int i, int
 
 namespace {
 
-/// The pixels of [x_begin, x_end) × [y_begin, y_end) with one sample each, traced as packets of
-/// 4×4 neighbouring pixels; the same values render_pixel gives one by one.
-void render_block_single_sample(const Scene& scene, const LectureShading& shading, int x_begin, int x_end, int y_begin,
-                                int y_end, Image& image, RayCounts& counts) {
+/// The camera rays of [x_begin, x_end) × [y_begin, y_end), one sample per pixel, in packets of
+/// 4×4 neighbouring pixels: `trace(rays, count, pixel_x, pixel_y)` is called once per packet.
+template <class TracePacket>
+void for_each_single_sample_packet(const Scene& scene, int x_begin, int x_end, int y_begin, int y_end,
+                                   TracePacket&& trace) {
     constexpr int side = 4;
     static_assert(side * side == Accelerator::packet_size);
     for (int by = y_begin; by < y_end; by += side) {
         for (int bx = x_begin; bx < x_end; bx += side) {
             PacketArray<Ray, Accelerator::packet_size> rays;
-            PacketArray<Color, Accelerator::packet_size> radiance;
             int pixel_x[Accelerator::packet_size], pixel_y[Accelerator::packet_size];
             int count = 0;
             for (int y = by; y < std::min(by + side, y_end); ++y) {
@@ -61,40 +61,38 @@ void render_block_single_sample(const Scene& scene, const LectureShading& shadin
                     ++count;
                 }
             }
-            shading.trace_packet(rays.data(), count, 0, radiance.data(), counts);
+            trace(rays.data(), count, pixel_x, pixel_y);
+        }
+    }
+}
+
+/// The pixels of [x_begin, x_end) × [y_begin, y_end) with one sample each, traced as packets of
+/// 4×4 neighbouring pixels; the same values render_pixel gives one by one.
+void render_block_single_sample(const Scene& scene, const LectureShading& shading, int x_begin, int x_end, int y_begin,
+                                int y_end, Image& image, RayCounts& counts) {
+    for_each_single_sample_packet(
+        scene, x_begin, x_end, y_begin, y_end, [&](const Ray* rays, int count, const int* pixel_x, const int* pixel_y) {
+            PacketArray<Color, Accelerator::packet_size> radiance;
+            shading.trace_packet(rays, count, 0, radiance.data(), counts);
             counts.camera += count;
             for (int k = 0; k < count; ++k) {
                 float* out = &image.rgb[3 * (size_t(pixel_y[k]) * scene.width + pixel_x[k])];
                 out[0] = float(radiance[k].x), out[1] = float(radiance[k].y), out[2] = float(radiance[k].z);
             }
-        }
-    }
+        });
 }
 
 /// render_block_single_sample with layers: the same packets, watched by a LayerRecorder.
 void render_block_layers_single_sample(const Scene& scene, const LectureShading& shading, LayerSet selection,
                                        int x_begin, int x_end, int y_begin, int y_end, Image& image,
                                        RayCounts& counts) {
-    constexpr int side = 4;
     LayerRecorder recorder(scene, Accelerator::packet_size);
     PixelLayers pixel;
-    for (int by = y_begin; by < y_end; by += side) {
-        for (int bx = x_begin; bx < x_end; bx += side) {
-            PacketArray<Ray, Accelerator::packet_size> rays;
+    for_each_single_sample_packet(
+        scene, x_begin, x_end, y_begin, y_end, [&](const Ray* rays, int count, const int* pixel_x, const int* pixel_y) {
             PacketArray<Color, Accelerator::packet_size> radiance;
-            int pixel_x[Accelerator::packet_size], pixel_y[Accelerator::packet_size];
-            int count = 0;
-            for (int y = by; y < std::min(by + side, y_end); ++y) {
-                for (int x = bx; x < std::min(bx + side, x_end); ++x) {
-                    double x0, y0;
-                    sample_position(x, y, 0, 0, 1, scene.width, scene.height, x0, y0);
-                    rays[count] = camera_ray(scene.camera, x0, y0);
-                    pixel_x[count] = x, pixel_y[count] = y;
-                    ++count;
-                }
-            }
             recorder.reset();
-            shading.trace_packet(rays.data(), count, 0, radiance.data(), counts, recorder);
+            shading.trace_packet(rays, count, 0, radiance.data(), counts, recorder);
             counts.camera += count;
             for (int k = 0; k < count; ++k) {
                 const size_t index = size_t(pixel_y[k]) * scene.width + pixel_x[k];
@@ -102,8 +100,7 @@ void render_block_layers_single_sample(const Scene& scene, const LectureShading&
                 pixel.add_sample(recorder.lane(k), true);
                 store_pixel_layers(pixel, selection, image.layers, index, &image.rgb[3 * index]);
             }
-        }
-    }
+        });
 }
 
 /// render_pixel with layers, for n×n samples: the same packets, watched by a LayerRecorder.
