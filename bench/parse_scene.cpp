@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: MIT
 // Times reading scene files (docs/performance.md, "Reading large scenes"): for each file, the
 // fast scanner and libyaml building the value tree alone (every object forgotten as it is read,
-// as parse.cpp does), and the whole parse_scene_file. Best of --runs, wall and CPU seconds.
+// as parse.cpp does), the whole parse_scene_file, and load_scene_file (parse and validate in one
+// pass, as `whitted render` reads a scene). Best of --runs, wall and CPU seconds.
 //   whitted_parse_bench [--runs N] [--parse-only] FILE...
 
 #include "whitted/scene/description.h"
+#include "whitted/scene/scene.h"
 #include "whitted/scene/text_checks.h"
 #include "whitted/scene/yaml_tree.h"
 
@@ -79,6 +81,10 @@ int main(int argc, char** argv) {
             const Seconds s = best_of(runs, [&] { parsed = whitted::parse_scene_file(path).objects.size(); });
             std::printf("%-28s %9.1f %-20s %10.3f %10.3f   (%zu objects)\n", name.c_str(), mb, "parse_scene_file",
                         s.wall, s.cpu, parsed);
+            // What `whitted render` does: parse and validate in one pass (scene.h).
+            const Seconds l = best_of(runs, [&] { parsed = whitted::load_scene_file(path).objects.size(); });
+            std::printf("%-28s %9.1f %-20s %10.3f %10.3f   (%zu objects)\n", name.c_str(), mb, "load_scene_file",
+                        l.wall, l.cpu, parsed);
         } catch (const std::exception& e) {
             std::fprintf(stderr, "whitted_parse_bench: %s\n", e.what());
             return 1;

@@ -283,7 +283,7 @@ int run_explain(const std::string& scene_path, const std::string& pixel, bool js
     int x = 0, y = 0;
     try {
         parse_pixel(pixel, x, y);  // usage first: nothing here reads the scene
-        scene = validate_scene(parse_scene_file(scene_path));
+        scene = load_scene_file(scene_path);
         if (x >= scene.width || y >= scene.height)
             throw std::invalid_argument(fmt::format("--pixel {},{} is outside the {}x{} image (X 0..{}, Y 0..{})", x, y,
                                                     scene.width, scene.height, scene.width - 1, scene.height - 1));

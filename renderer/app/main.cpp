@@ -159,13 +159,6 @@ void refuse_output_over(const std::string& output, const std::string& input, con
                                     input + "'");
 }
 
-void collect_mesh_files(const std::vector<ObjectDescription>& objects, std::vector<std::string>& files) {
-    for (const ObjectDescription& object : objects) {
-        if (!object.file_path.empty()) files.push_back(object.file_path);
-        collect_mesh_files(object.children, files);
-    }
-}
-
 /// Wall-clock time of each stage, printed by --stats.
 class StageTimer {
 public:
@@ -184,7 +177,7 @@ private:
 int run_render(const RenderArguments& args) {
     StageTimer timer;
     Scene scene;
-    double parse_seconds = 0, validate_seconds = 0;
+    double read_seconds = 0;
     install_signal_handlers();
     OutputOptions output = output_options(args);
     LayerSet layers;
@@ -197,8 +190,11 @@ int run_render(const RenderArguments& args) {
         }
         check_output_options(args.output, output);
         refuse_output_over(args.output, args.scene, "scene file");
-        const SceneDescription description = parse_scene_file(args.scene);
-        parse_seconds = timer.lap();
+        // Parsed and validated in one pass (load_scene_file): a million objects are never all
+        // held as descriptions. `description` is the rest of the file, without the objects.
+        SceneDescription description;
+        scene = load_scene_file(args.scene, &description);
+        read_seconds = timer.lap();
         if (args.layers.empty() && !description.layers.empty()) {
             // The scene's render.layers, unless --layers was given (--layers none turns them off).
             std::vector<std::string> names;
@@ -213,11 +209,7 @@ int run_render(const RenderArguments& args) {
                 check_output_options(args.output, output);
             }
         }
-        std::vector<std::string> meshes;
-        collect_mesh_files(description.objects, meshes);
-        for (const std::string& mesh : meshes) refuse_output_over(args.output, mesh, "mesh file");
-        scene = validate_scene(description);
-        validate_seconds = timer.lap();
+        for (const std::string& mesh : scene.mesh_files) refuse_output_over(args.output, mesh, "mesh file");
         // The colour layers split each hit's terms at weight 1; a glazed (fresnel_ior) material
         // scales them by 1 − F, which the layers do not yet follow, so they would not add up.
         if (!layers.empty())
@@ -283,10 +275,10 @@ int run_render(const RenderArguments& args) {
         if (args.stats)
             std::fprintf(
                 stderr,
-                "whitted: stages: parse %.3fs, validate+load %.3fs, build BVH %.3fs, render %.3fs, write %.3fs; "
+                "whitted: stages: read (parse, validate, load meshes) %.3fs, build BVH %.3fs, render %.3fs, write %.3fs; "
                 "%zu triangles, %zu spheres, %zu boxes, %zu planes, %zu lights; BVH %.1f MB (%.1f MB while "
                 "building); Embree %s, %d-wide packets\n",
-                parse_seconds, validate_seconds, build_seconds, result.seconds, write_seconds, scene.triangle_count(),
+                read_seconds, build_seconds, result.seconds, write_seconds, scene.triangle_count(),
                 scene.spheres.size(), scene.boxes.size(), scene.planes.size(), scene.lights.size(),
                 double(accelerator.embree_bytes()) / 1e6, double(accelerator.peak_embree_bytes()) / 1e6,
                 accelerator.isa().empty() ? "(its choice)" : accelerator.isa().c_str(), accelerator.lane_width());

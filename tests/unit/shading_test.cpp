@@ -111,14 +111,14 @@ TEST(Shading, ShadowedLightAddsNeitherTerm) {
     const double ks = 0.5, p = 4;
     Scene scene = floor_scene(material(ka, kd, Color(ks), p));
     scene.lights = {point_light({0, 5, 0}, Color(1.0))};
-    scene.spheres = {{Transform(), {0, 2.5, 0}, 0.5, 0}};
+    scene.spheres = {{nullptr, {0, 2.5, 0}, 0.5, 0}};
     expect_color_near(trace_from(scene, eye, {0, 0, 0}), ka, tolerance);
 
     // l = (0, 1, 0): n·l = 1, n·h = (1 + 1/√2)/|(0, 1 + 1/√2, 1/√2)|.
     const double s2 = std::sqrt(2.0);
     const double n_dot_h = (1 + 1 / s2) / length(Vec3{0, 1 + 1 / s2, 1 / s2});
     const Color lit = ka + kd + Color(ks * std::pow(n_dot_h, p));
-    scene.spheres = {{Transform(), {0, 7, 0}, 0.5, 0}};  // beyond the light: no shadow
+    scene.spheres = {{nullptr, {0, 7, 0}, 0.5, 0}};  // beyond the light: no shadow
     expect_color_near(trace_from(scene, eye, {0, 0, 0}), lit, tolerance);
     scene.spheres.clear();
     expect_color_near(trace_from(scene, eye, {0, 0, 0}), lit, tolerance);
@@ -143,7 +143,7 @@ TEST(Shading, DirectionalLightIsShadowed) {
     const Vec3 direction{1, -2, 0.5};
     scene.lights = {directional_light(direction, Color(1.0))};
     const Vec3 up_beam = -normalize(direction) * 100.0;  // 100 units toward the light from the origin
-    scene.spheres = {{Transform(), up_beam, 1.0, 0}};
+    scene.spheres = {{nullptr, up_beam, 1.0, 0}};
     expect_color_near(trace_from(scene, eye, {0, 0, 0}), ka, tolerance);
 }
 

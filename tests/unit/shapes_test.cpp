@@ -25,7 +25,7 @@ void expect_vec_near(const Vec3& actual, const Vec3& expected, double tol) {
 }
 
 TEST(Sphere, HitFromOutsideHeadOn) {
-    const Sphere sphere{Transform(), {1, 2, 3}, 2, 0};
+    const Sphere sphere{nullptr, {1, 2, 3}, 2, 0};
     ShapeHit hit;
     ASSERT_TRUE(intersect_sphere(sphere, ray_from({1, 2, 10}, {0, 0, -1}), t_min, t_max, hit));
     EXPECT_NEAR(hit.t, 10.0 - 3.0 - 2.0, 1e-12);  // from z = 10 to the near pole at z = 3 + 2
@@ -35,7 +35,7 @@ TEST(Sphere, HitFromOutsideHeadOn) {
 // Aimed at the centre of a sphere at (5, 5, 0) from the origin: the near surface is r short of
 // the centre's distance 5√2.
 TEST(Sphere, HitFromOutsideOblique) {
-    const Sphere sphere{Transform(), {5, 5, 0}, 1, 0};
+    const Sphere sphere{nullptr, {5, 5, 0}, 1, 0};
     ShapeHit hit;
     ASSERT_TRUE(intersect_sphere(sphere, ray_from({0, 0, 0}, {1, 1, 0}), t_min, t_max, hit));
     EXPECT_NEAR(hit.t, 5 * std::sqrt(2.0) - 1, 1e-12);
@@ -45,7 +45,7 @@ TEST(Sphere, HitFromOutsideOblique) {
 // From the centre the ray meets the far side at t = r, and the normal is still the outward one
 // (turning it toward the ray is the shader's job).
 TEST(Sphere, HitFromInsideReturnsFarSideWithOutwardNormal) {
-    const Sphere sphere{Transform(), {0, 0, 0}, 3, 0};
+    const Sphere sphere{nullptr, {0, 0, 0}, 3, 0};
     ShapeHit hit;
     ASSERT_TRUE(intersect_sphere(sphere, ray_from({0, 0, 0}, {0, 1, 0}), t_min, t_max, hit));
     EXPECT_NEAR(hit.t, 3.0, 1e-12);
@@ -56,7 +56,7 @@ TEST(Sphere, HitFromInsideReturnsFarSideWithOutwardNormal) {
 }
 
 TEST(Sphere, MissesBehindBesideAndBeyondRange) {
-    const Sphere sphere{Transform(), {0, 0, -5}, 1, 0};
+    const Sphere sphere{nullptr, {0, 0, -5}, 1, 0};
     ShapeHit hit;
     EXPECT_FALSE(intersect_sphere(sphere, ray_from({0, 0, 0}, {0, 0, 1}), t_min, t_max, hit));      // behind
     EXPECT_FALSE(intersect_sphere(sphere, ray_from({1.01, 0, 0}, {0, 0, -1}), t_min, t_max, hit));  // beside
@@ -67,7 +67,11 @@ TEST(Sphere, MissesBehindBesideAndBeyondRange) {
 // The unit sphere scaled by (2, 1, 1) is the ellipsoid x²/4 + y² + z² = 1, whose normal is the
 // gradient ∝ (x/4, y, z): the inverse transpose of the scale, not the scaled radius vector.
 TEST(Sphere, NonUniformScaleUsesInverseTransposeNormal) {
-    const Sphere sphere{Transform::scale({2, 1, 1}).then(Transform::translate({0, 3, 0})), {0, 0, 0}, 1, 0};
+    const Sphere sphere{
+        std::make_shared<const Transform>(Transform::scale({2, 1, 1}).then(Transform::translate({0, 3, 0}))),
+        {0, 0, 0},
+        1,
+        0};
     ShapeHit hit;
     // Along x = 1, y = 3 (object y = 0): 1/4 + z² = 1 gives z = √3/2 on the near side.
     ASSERT_TRUE(intersect_sphere(sphere, ray_from({1, 3, 10}, {0, 0, -1}), t_min, t_max, hit));
@@ -80,7 +84,11 @@ TEST(Sphere, NonUniformScaleUsesInverseTransposeNormal) {
 }
 
 TEST(Sphere, WorldBoundsOfScaledSphere) {
-    const Sphere sphere{Transform::scale({2, 1, 0.5}).then(Transform::translate({1, 1, 1})), {0, 0, 0}, 1, 0};
+    const Sphere sphere{
+        std::make_shared<const Transform>(Transform::scale({2, 1, 0.5}).then(Transform::translate({1, 1, 1}))),
+        {0, 0, 0},
+        1,
+        0};
     Vec3 lo, hi;
     world_bounds(sphere, lo, hi);
     expect_vec_near(lo, {-1, 0, 0.5}, 1e-12);
@@ -90,7 +98,7 @@ TEST(Sphere, WorldBoundsOfScaledSphere) {
 // A ray toward the centre from outside each of the six faces of a non-cubic box hits that face
 // at (5 − half-extent) with that face's outward normal.
 TEST(Box, EachFaceFromOutside) {
-    const Box box{Transform(), {-1, -2, -3}, {1, 2, 3}, 0};
+    const Box box{nullptr, {-1, -2, -3}, {1, 2, 3}, 0};
     const Vec3 half{1, 2, 3};
     for (int axis = 0; axis < 3; ++axis) {
         for (const double sign : {-1.0, 1.0}) {
@@ -106,7 +114,7 @@ TEST(Box, EachFaceFromOutside) {
 }
 
 TEST(Box, FromInsideHitsTheExitFace) {
-    const Box box{Transform(), {-1, -1, -1}, {1, 1, 1}, 0};
+    const Box box{nullptr, {-1, -1, -1}, {1, 1, 1}, 0};
     ShapeHit hit;
     ASSERT_TRUE(intersect_box(box, ray_from({0.5, 0, 0}, {1, 0, 0}), t_min, t_max, hit));
     EXPECT_NEAR(hit.t, 0.5, 1e-12);
@@ -118,7 +126,7 @@ TEST(Box, FromInsideHitsTheExitFace) {
 }
 
 TEST(Box, MissesParallelOutsideSlabAndBehind) {
-    const Box box{Transform(), {-1, -1, -1}, {1, 1, 1}, 0};
+    const Box box{nullptr, {-1, -1, -1}, {1, 1, 1}, 0};
     ShapeHit hit;
     EXPECT_FALSE(intersect_box(box, ray_from({0, 1.5, 5}, {0, 0, -1}), t_min, t_max, hit));  // above the y slab
     EXPECT_FALSE(intersect_box(box, ray_from({0, 0, 5}, {0, 0, 1}), t_min, t_max, hit));     // box behind
@@ -127,7 +135,7 @@ TEST(Box, MissesParallelOutsideSlabAndBehind) {
 
 // A box turned 90° about z: its object x face now faces world +y, with the normal carried along.
 TEST(Box, RotatedBoxNormalFollowsTransform) {
-    const Box box{Transform::rotate({0, 0, 1}, 90), {-1, -2, -3}, {1, 2, 3}, 0};
+    const Box box{std::make_shared<const Transform>(Transform::rotate({0, 0, 1}, 90)), {-1, -2, -3}, {1, 2, 3}, 0};
     ShapeHit hit;
     // World +y extent is the object x extent (1).
     ASSERT_TRUE(intersect_box(box, ray_from({0, 10, 0}, {0, -1, 0}), t_min, t_max, hit));
@@ -220,7 +228,7 @@ TEST(Triangle, PlaneHitClampsBarycentricsOntoTheTriangle) {
 TEST(Sphere, SmallAndFarStaysAccurate) {
     for (const double distance : {1e3, 1e5, 1e6}) {
         const double r = 1e-3;
-        const Sphere sphere{Transform(), {0.3, -0.2, distance}, r, 0};
+        const Sphere sphere{nullptr, {0.3, -0.2, distance}, r, 0};
         for (const double offset : {0.0, 0.5 * r, 0.9 * r}) {
             ShapeHit hit;
             const Ray ray{{0.3 + offset, -0.2, 0}, {0, 0, 1}, t_min, 1e9};

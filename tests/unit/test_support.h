@@ -51,9 +51,16 @@ std::optional<InputError> input_error_from(F&& f) {
     return std::nullopt;
 }
 
-/// The error that parsing (and then validating) `text` gives.
+/// The error that parsing (and then validating) `text` gives. The one-pass reader the program
+/// uses (load_scene_text) must give the same one, at the same place: every error test checks both.
 inline std::optional<InputError> scene_error(const std::string& text, const std::string& path = "scene.yaml") {
-    return input_error_from([&] { (void)validate_scene(parse_scene_text(text, path)); });
+    std::optional<InputError> two_pass = input_error_from([&] { (void)validate_scene(parse_scene_text(text, path)); });
+    std::optional<InputError> one_pass = input_error_from([&] { (void)load_scene_text(text, path); });
+    if (two_pass && one_pass) {
+        EXPECT_EQ(std::string(one_pass->what()), std::string(two_pass->what()))
+            << "load_scene_text and validate_scene(parse_scene_text) disagree";
+    }
+    return two_pass;
 }
 
 /// The validated scene for `text`.

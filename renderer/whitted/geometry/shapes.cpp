@@ -58,21 +58,21 @@ inline bool sphere_hit(const Sphere& sphere, const Vec3& origin, const Vec3& dir
 
 bool intersect_sphere(const Sphere& sphere, const Ray& world_ray, double t_min, double t_max, ShapeHit& hit) {
     double t;
-    if (sphere.object_to_world.is_identity()) {
+    if (!sphere.object_to_world) {
         if (!sphere_hit(sphere, world_ray.origin, world_ray.direction, t_min, t_max, t)) return false;
         hit.t = t;
         hit.normal = (world_ray.at(t) - sphere.center) / sphere.radius;
         return true;
     }
-    const Ray ray = to_object_space(sphere.object_to_world, world_ray);
+    const Ray ray = to_object_space(*sphere.object_to_world, world_ray);
     if (!sphere_hit(sphere, ray.origin, ray.direction, t_min, t_max, t)) return false;
     hit.t = t;
-    hit.normal = sphere.object_to_world.apply_normal((ray.at(t) - sphere.center) / sphere.radius);
+    hit.normal = sphere.object_to_world->apply_normal((ray.at(t) - sphere.center) / sphere.radius);
     return true;
 }
 
 bool intersect_box(const Box& box, const Ray& world_ray, double t_min, double t_max, ShapeHit& hit) {
-    const Ray ray = to_object_space(box.object_to_world, world_ray);
+    const Ray ray = to_object_space(transform_of(box.object_to_world), world_ray);
     double t_near = -std::numeric_limits<double>::infinity();
     double t_far = std::numeric_limits<double>::infinity();
     int near_axis = -1, far_axis = -1;
@@ -101,7 +101,7 @@ bool intersect_box(const Box& box, const Ray& world_ray, double t_min, double t_
     } else {
         return false;
     }
-    hit.normal = box.object_to_world.is_identity() ? object_normal : box.object_to_world.apply_normal(object_normal);
+    hit.normal = box.object_to_world ? box.object_to_world->apply_normal(object_normal) : object_normal;
     return true;
 }
 
@@ -162,12 +162,14 @@ bool hit_triangle_plane(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Ra
 }
 
 void world_bounds(const Sphere& sphere, Vec3& lo, Vec3& hi) {
-    bounds_of_transformed_box(sphere.object_to_world, sphere.center - Vec3(sphere.radius),
-                              sphere.center + Vec3(sphere.radius), lo, hi);
+    lo = sphere.center - Vec3(sphere.radius);
+    hi = sphere.center + Vec3(sphere.radius);
+    // Embree asks once per sphere while building: the eight corners only when there is a transform.
+    if (sphere.object_to_world) bounds_of_transformed_box(*sphere.object_to_world, Vec3(lo), Vec3(hi), lo, hi);
 }
 
 void world_bounds(const Box& box, Vec3& lo, Vec3& hi) {
-    bounds_of_transformed_box(box.object_to_world, box.min, box.max, lo, hi);
+    bounds_of_transformed_box(transform_of(box.object_to_world), box.min, box.max, lo, hi);
 }
 
 }  // namespace whitted

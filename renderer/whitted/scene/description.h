@@ -11,6 +11,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -197,11 +198,17 @@ inline constexpr int64_t max_triangles = int64_t(64) << 20;  // 67 M triangles
 inline constexpr int64_t max_yaml_nodes = 10'000'000;
 }  // namespace limits
 
+/// Receives each top-level object as soon as it is parsed, with its index in `objects`, so that a
+/// reader can use it and let it go (load_scene_file). If the reader has to start again (a file the
+/// fast scanner hands to libyaml, yaml_tree.h), index 0 comes again: start over.
+using ObjectSink = std::function<void(ObjectDescription&&, size_t index)>;
+
 /// Reads a scene file (YAML or JSON; a `.xml` file is read as a Cornell CS4620 course scene,
-/// course_xml.h). Throws InputError naming file:line:col on any problem.
-SceneDescription parse_scene_file(const std::string& path);
+/// course_xml.h). Throws InputError naming file:line:col on any problem. With a `sink`, the
+/// top-level objects go there (only until the first mistake in them) and `objects` stays empty.
+SceneDescription parse_scene_file(const std::string& path, const ObjectSink* sink = nullptr);
 /// Same, from text already in memory; `path` is used for messages and relative mesh paths.
-SceneDescription parse_scene_text(std::string_view text, const std::string& path);
+SceneDescription parse_scene_text(std::string_view text, const std::string& path, const ObjectSink* sink = nullptr);
 
 const char* to_string(ObjectType type);
 

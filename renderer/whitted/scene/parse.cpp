@@ -22,11 +22,33 @@ namespace {
 
 using Node = yaml_tree::Node;
 
+/// A value's name in messages, such as "objects[3] (sphere).center": a prefix and a key, joined
+/// only when a message is written. A million objects read without a mistake need no names, and
+/// building them cost a fifth of the time spent reading a file of spheres (docs/performance.md).
+/// Holds a reference: pass it down, never keep it.
+class What {
+public:
+    What(const std::string& name) : m_prefix(name) {}  // NOLINT: implicit, names used to be strings
+    What(const std::string& prefix, std::string_view key) : m_prefix(prefix), m_key(key) {}
+    std::string str() const { return m_key.empty() ? m_prefix : m_prefix + "." + std::string(m_key); }
+    friend std::string operator+(const What& what, std::string_view tail) {
+        std::string text = what.str();
+        text += tail;
+        return text;
+    }
+
+private:
+    const std::string& m_prefix;
+    std::string_view m_key;
+};
+
 struct ParseContext {
     FileName file;
     std::string directory;
     std::vector<ObjectDescription> objects;  ///< the top-level objects, parsed as they are read
     std::exception_ptr objects_error;        ///< the first mistake in them, reported in turn
+    /// Given: each top-level object goes here as soon as it is parsed, instead of into `objects`.
+    const ObjectSink* sink = nullptr;
 
     SourceLocation at(const Node& node) const {
         SourceLocation where = node.location();
@@ -53,7 +75,7 @@ std::string describe(const Node& node) {
     }
 }
 
-double parse_number(const ParseContext& ctx, const Node& node, const std::string& what) {
+double parse_number(const ParseContext& ctx, const Node& node, const What& what) {
     if (!node.IsScalar() || node.IsQuoted()) ctx.fail(node, what + ": expected a number, got " + describe(node));
     const std::string_view whole = node.scalar_view();
     const auto text = [&] { return printable(whole, 40); };  // for messages only
@@ -76,27 +98,27 @@ double parse_number(const ParseContext& ctx, const Node& node, const std::string
     return value;
 }
 
-int64_t parse_integer(const ParseContext& ctx, const Node& node, const std::string& what) {
+int64_t parse_integer(const ParseContext& ctx, const Node& node, const What& what) {
     const double value = parse_number(ctx, node, what);
     if (value != std::floor(value) || std::fabs(value) > 9.0e15)
         ctx.fail(node, what + ": expected a whole number, got " + describe(node));
     return static_cast<int64_t>(value);
 }
 
-Vec3 parse_vec3(const ParseContext& ctx, const Node& node, const std::string& what) {
+Vec3 parse_vec3(const ParseContext& ctx, const Node& node, const What& what) {
     if (!node.IsSequence()) ctx.fail(node, what + ": expected a list of 3 numbers [x, y, z], got " + describe(node));
     if (node.size() != 3) ctx.fail(node, what + ": expected 3 numbers, got a list of " + std::to_string(node.size()));
     return {parse_number(ctx, node[0], what), parse_number(ctx, node[1], what), parse_number(ctx, node[2], what)};
 }
 
 /// A colour: [r, g, b], or one number c meaning [c, c, c].
-Color parse_color(const ParseContext& ctx, const Node& node, const std::string& what) {
+Color parse_color(const ParseContext& ctx, const Node& node, const What& what) {
     if (node.IsScalar()) return Color(parse_number(ctx, node, what));
     if (!node.IsSequence()) ctx.fail(node, what + ": expected a colour [r, g, b] or a number, got " + describe(node));
     return parse_vec3(ctx, node, what);
 }
 
-std::string parse_string(const ParseContext& ctx, const Node& node, const std::string& what) {
+std::string parse_string(const ParseContext& ctx, const Node& node, const What& what) {
     if (!node.IsScalar()) ctx.fail(node, what + ": expected a name, got " + describe(node));
     return node.Scalar();
 }
@@ -130,44 +152,55 @@ std::string did_you_mean(const std::string& word, const std::vector<std::string>
 
 namespace {
 
-std::string join(const std::vector<std::string>& words) {
+std::string join(const std::vector<std::string>& words) {  // for messages
     std::string out;
     for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
     return out;
 }
 
-/// Reads one YAML map: rejects unknown keys (with a suggestion) and finds values by key.
+/// Reads one YAML map: rejects unknown keys (with a suggestion) and finds values by key. The
+/// allowed keys and the keys found are views (of string literals and of the document), kept in
+/// place: a reader is made for every object of a file that may hold millions.
 class MapReader {
 public:
-    MapReader(ParseContext& ctx, const Node& node, std::string what, std::vector<std::string> allowed)
-        : m_ctx(ctx), m_node(node), m_what(std::move(what)), m_allowed(std::move(allowed)) {
+    static constexpr size_t max_keys = 12;
+
+    MapReader(ParseContext& ctx, const Node& node, std::string what, std::initializer_list<std::string_view> allowed)
+        : MapReader(ctx, node, std::move(what), allowed.begin(), allowed.size()) {}
+    MapReader(ParseContext& ctx, const Node& node, std::string what, const std::string_view* allowed, size_t count)
+        : m_ctx(ctx), m_node(node), m_what(std::move(what)), m_allowed_count(count) {
+        if (count > max_keys) throw std::logic_error("MapReader: too many keys");
+        std::copy(allowed, allowed + count, m_allowed.begin());
         if (!node.IsMap()) ctx.fail(node, m_what + ": expected a map of keys, got " + describe(node));
-        m_keys.reserve(node.size());
         for (const auto& entry : node.pairs()) {
             const Node& key = entry.first;
             if (!key.IsScalar()) ctx.fail(key, m_what + ": keys must be plain names");
-            const std::string name = key.Scalar();
-            if (std::find(m_allowed.begin(), m_allowed.end(), name) == m_allowed.end())
-                ctx.fail(key, m_what + ": unknown key '" + printable(name) + "'" + did_you_mean(name, m_allowed) +
-                                  "; expected one of: " + join(m_allowed));
-            for (const auto& seen : m_keys)
-                if (seen == name) ctx.fail(key, m_what + ": key '" + printable(name) + "' is given twice");
-            m_keys.push_back(name);
+            const std::string_view name = key.scalar_view();
+            if (std::find(allowed_begin(), allowed_end(), name) == allowed_end()) {
+                const std::vector<std::string> names(allowed_begin(), allowed_end());
+                ctx.fail(key, m_what + ": unknown key '" + printable(name) + "'" +
+                                  did_you_mean(std::string(name), names) + "; expected one of: " + join(names));
+            }
+            if (has(name)) ctx.fail(key, m_what + ": key '" + printable(name) + "' is given twice");
+            m_keys[m_key_count++] = name;  // room: every key is allowed and none is given twice
         }
     }
 
-    bool has(const std::string& key) const { return std::find(m_keys.begin(), m_keys.end(), key) != m_keys.end(); }
-    Node get(const std::string& key) const { return m_node[key]; }
+    bool has(std::string_view key) const {
+        return std::find(m_keys.begin(), m_keys.begin() + m_key_count, key) != m_keys.begin() + m_key_count;
+    }
+    Node get(std::string_view key) const { return m_node[key]; }
     SourceLocation where() const { return m_ctx.at(m_node); }
-    std::string what(const std::string& key) const { return m_what + "." + key; }
+    const std::string& name() const { return m_what; }
+    What what(std::string_view key) const { return What(m_what, key); }
 
-    Node require(const std::string& key) const {
-        if (!has(key)) m_ctx.fail(m_node, m_what + ": missing required key '" + key + "'");
+    Node require(std::string_view key) const {
+        if (!has(key)) m_ctx.fail(m_node, m_what + ": missing required key '" + std::string(key) + "'");
         return get(key);
     }
 
     template <class T, class ParseFn>
-    void read(Located<T>& out, const std::string& key, ParseFn parse, bool required = false) const {
+    void read(Located<T>& out, std::string_view key, ParseFn parse, bool required = false) const {
         if (!has(key)) {
             if (required) require(key);
             out.where = where();
@@ -178,30 +211,35 @@ public:
         out.where = m_ctx.at(value);
         out.given = true;
     }
-    void number(Located<double>& out, const std::string& key, bool required = false) const {
+    void number(Located<double>& out, std::string_view key, bool required = false) const {
         read(out, key, parse_number, required);
     }
-    void integer(Located<int64_t>& out, const std::string& key, bool required = false) const {
+    void integer(Located<int64_t>& out, std::string_view key, bool required = false) const {
         read(out, key, parse_integer, required);
     }
-    void vec3(Located<Vec3>& out, const std::string& key, bool required = false) const {
+    void vec3(Located<Vec3>& out, std::string_view key, bool required = false) const {
         read(out, key, parse_vec3, required);
     }
-    void color(Located<Color>& out, const std::string& key, bool required = false) const {
+    void color(Located<Color>& out, std::string_view key, bool required = false) const {
         read(out, key, parse_color, required);
     }
 
 private:
+    const std::string_view* allowed_begin() const { return m_allowed.data(); }
+    const std::string_view* allowed_end() const { return m_allowed.data() + m_allowed_count; }
+
     ParseContext& m_ctx;
     Node m_node;
     std::string m_what;
-    std::vector<std::string> m_allowed;
-    std::vector<std::string> m_keys;
+    std::array<std::string_view, max_keys> m_allowed{};
+    size_t m_allowed_count = 0;
+    std::array<std::string_view, max_keys> m_keys{};
+    size_t m_key_count = 0;
 };
 
 /// Picks one of a fixed set of words, e.g. a camera type.
 template <class Enum>
-Enum parse_choice(const ParseContext& ctx, const Node& node, const std::string& what,
+Enum parse_choice(const ParseContext& ctx, const Node& node, const What& what,
                   const std::vector<std::pair<std::string, Enum>>& choices) {
     const std::string word = parse_string(ctx, node, what);
     for (const auto& [name, value] : choices)
@@ -227,7 +265,7 @@ CameraDescription parse_camera(ParseContext& ctx, const Node& node) {
                    "image_plane_normal"});
     CameraDescription camera;
     camera.where = map.where();
-    map.read(camera.type, "type", [](const ParseContext& c, const Node& n, const std::string& w) {
+    map.read(camera.type, "type", [](const ParseContext& c, const Node& n, const What& w) {
         return parse_choice<CameraType>(
             c, n, w, {{"perspective", CameraType::perspective}, {"orthographic", CameraType::orthographic}});
     });
@@ -281,7 +319,7 @@ MaterialDescription parse_material(ParseContext& ctx, const Node& node, const st
     map.color(material.ks, "ks");
     map.number(material.p, "p");
     map.color(material.km, "km");
-    map.read(material.highlight, "highlight", [](const ParseContext& c, const Node& n, const std::string& w) {
+    map.read(material.highlight, "highlight", [](const ParseContext& c, const Node& n, const What& w) {
         return parse_choice<Highlight>(c, n, w, {{"blinn", Highlight::blinn}, {"phong", Highlight::phong}});
     });
     map.number(material.fresnel_ior, "fresnel_ior");
@@ -291,7 +329,7 @@ MaterialDescription parse_material(ParseContext& ctx, const Node& node, const st
     return material;
 }
 
-MaterialReference parse_material_reference(ParseContext& ctx, const Node& node, const std::string& what) {
+MaterialReference parse_material_reference(ParseContext& ctx, const Node& node, const What& what) {
     MaterialReference reference;
     reference.where = ctx.at(node);
     if (node.IsScalar() && !node.IsQuoted() && node.Scalar().empty())
@@ -299,14 +337,14 @@ MaterialReference parse_material_reference(ParseContext& ctx, const Node& node, 
     if (node.IsScalar()) {
         reference.name = node.Scalar();
     } else if (node.IsMap()) {
-        reference.inline_ = parse_material(ctx, node, what);
+        reference.inline_ = parse_material(ctx, node, what.str());
     } else {
         ctx.fail(node, what + ": expected a material name or an inline material map, got " + describe(node));
     }
     return reference;
 }
 
-std::vector<TransformStep> parse_transform(ParseContext& ctx, const Node& node, const std::string& what) {
+std::vector<TransformStep> parse_transform(ParseContext& ctx, const Node& node, const What& what) {
     const auto parse_step = [&](const Node& step_node, const std::string& step_what) {
         MapReader map(ctx, step_node, step_what, {"scale", "rotate", "translate", "matrix"});
         int count = map.has("scale") + map.has("rotate") + map.has("translate") + map.has("matrix");
@@ -346,7 +384,7 @@ std::vector<TransformStep> parse_transform(ParseContext& ctx, const Node& node, 
 
     std::vector<TransformStep> steps;
     if (node.IsMap()) {
-        steps.push_back(parse_step(node, what));
+        steps.push_back(parse_step(node, what.str()));
     } else if (node.IsSequence()) {
         for (size_t i = 0; i < node.size(); ++i)
             steps.push_back(parse_step(node[i], what + "[" + std::to_string(i) + "]"));
@@ -358,7 +396,7 @@ std::vector<TransformStep> parse_transform(ParseContext& ctx, const Node& node, 
     return steps;
 }
 
-std::vector<Vec3> parse_vec3_list(ParseContext& ctx, const Node& node, const std::string& what) {
+std::vector<Vec3> parse_vec3_list(ParseContext& ctx, const Node& node, const What& what) {
     if (!node.IsSequence()) ctx.fail(node, what + ": expected a list of [x, y, z], got " + describe(node));
     std::vector<Vec3> out;
     out.reserve(node.size());
@@ -373,6 +411,7 @@ std::vector<ObjectDescription> parse_objects(ParseContext& ctx, const Node& node
     if (node.IsNull()) return {};
     if (node.IsStreamed()) {  // the top-level list, parsed while it was read
         if (ctx.objects_error) std::rethrow_exception(ctx.objects_error);
+        if (ctx.sink) return {};
         if (ctx.objects.size() < ctx.objects.capacity() / 2) ctx.objects.shrink_to_fit();
         return std::move(ctx.objects);
     }
@@ -393,30 +432,35 @@ ObjectDescription parse_object(ParseContext& ctx, const Node& node, const std::s
         {"sphere", ObjectType::sphere},     {"plane", ObjectType::plane}, {"box", ObjectType::box},
         {"triangle", ObjectType::triangle}, {"mesh", ObjectType::mesh},   {"group", ObjectType::group}};
     object.type = parse_choice<ObjectType>(ctx, type_node, what + ".type", object_types);
-    const std::string label = what + " (" + to_string(object.type) + ")";
-    std::vector<std::string> keys{"type", "transform"};
-    if (object.type != ObjectType::group) keys.push_back("material");
+    // The keys each type takes: type, transform, material (not for groups), then its own.
+    std::array<std::string_view, MapReader::max_keys> keys{"type", "transform"};
+    size_t key_count = 2;
+    const auto allow = [&](std::initializer_list<std::string_view> more) {
+        for (const std::string_view key : more) keys[key_count++] = key;
+    };
+    if (object.type != ObjectType::group) allow({"material"});
     switch (object.type) {
         case ObjectType::sphere:
-            keys.insert(keys.end(), {"center", "radius"});
+            allow({"center", "radius"});
             break;
         case ObjectType::plane:
-            keys.insert(keys.end(), {"point", "normal"});
+            allow({"point", "normal"});
             break;
         case ObjectType::box:
-            keys.insert(keys.end(), {"min", "max"});
+            allow({"min", "max"});
             break;
         case ObjectType::triangle:
-            keys.insert(keys.end(), {"vertices"});
+            allow({"vertices"});
             break;
         case ObjectType::mesh:
-            keys.insert(keys.end(), {"file", "vertices", "triangles", "normals"});
+            allow({"file", "vertices", "triangles", "normals"});
             break;
         case ObjectType::group:
-            keys.insert(keys.end(), {"objects"});
+            allow({"objects"});
             break;
     }
-    MapReader map(ctx, node, label, keys);
+    MapReader map(ctx, node, what + " (" + to_string(object.type) + ")", keys.data(), key_count);
+    const std::string& label = map.name();
     object.where = map.where();
     if (map.has("transform")) object.transform = parse_transform(ctx, map.get("transform"), label + ".transform");
     if (map.has("material")) object.material = parse_material_reference(ctx, map.get("material"), label + ".material");
@@ -512,7 +556,7 @@ std::vector<Located<std::string>> parse_render_layers(ParseContext& ctx, const N
 /// `render.convention` and `render.min_weight`: the Cornell course's shading rules, kept out of
 /// the default (POV-Ray's) path.
 void parse_render_conventions(const MapReader& render, SceneDescription& scene) {
-    render.read(scene.convention, "convention", [](const ParseContext& c, const Node& n, const std::string& w) {
+    render.read(scene.convention, "convention", [](const ParseContext& c, const Node& n, const What& w) {
         return parse_choice<Convention>(c, n, w, {{"pov", Convention::pov}, {"course", Convention::course}});
     });
     render.number(scene.min_weight, "min_weight");
@@ -596,8 +640,9 @@ const char* to_string(ObjectType type) {
     return "object";
 }
 
-SceneDescription parse_scene_text(std::string_view text, const std::string& path) {
+SceneDescription parse_scene_text(std::string_view text, const std::string& path, const ObjectSink* sink) {
     ParseContext ctx;
+    ctx.sink = sink;
     ctx.file = path;
     ctx.directory = std::filesystem::path(path).parent_path().string();
     check_text_is_readable(text, path);
@@ -606,7 +651,7 @@ SceneDescription parse_scene_text(std::string_view text, const std::string& path
     // text at least): moving hundreds of thousands of descriptions each time the list grows cost
     // more than reading them. Pages never written are never resident; what is left is given back.
     try {
-        ctx.objects.reserve(std::min<size_t>(text.size() / 64, size_t(1) << 24));
+        if (!sink) ctx.objects.reserve(std::min<size_t>(text.size() / 64, size_t(1) << 24));
     } catch (const std::bad_alloc&) {  // a machine without overcommit: grow as needed
     }
     // Each top-level object is parsed as soon as it is read; its first mistake is kept and
@@ -616,7 +661,11 @@ SceneDescription parse_scene_text(std::string_view text, const std::string& path
         if (index == 0) ctx.objects.clear(), ctx.objects_error = nullptr;  // read again by libyaml
         if (ctx.objects_error) return;
         try {
-            ctx.objects.push_back(parse_object(ctx, item, "objects[" + std::to_string(index) + "]", 0));
+            ObjectDescription object = parse_object(ctx, item, "objects[" + std::to_string(index) + "]", 0);
+            if (ctx.sink)
+                (*ctx.sink)(std::move(object), index);
+            else
+                ctx.objects.push_back(std::move(object));
         } catch (const InputError&) {
             ctx.objects_error = std::current_exception();
         }
@@ -627,12 +676,19 @@ SceneDescription parse_scene_text(std::string_view text, const std::string& path
     return parse_document(ctx, document.root());
 }
 
-SceneDescription parse_scene_file(const std::string& path) {
-    if (is_course_xml_path(path)) return parse_course_xml_file(path);  // the Cornell course's XML scenes
+SceneDescription parse_scene_file(const std::string& path, const ObjectSink* sink) {
+    if (is_course_xml_path(path)) {  // the Cornell course's XML scenes: small; handed over whole
+        SceneDescription description = parse_course_xml_file(path);
+        if (sink) {
+            for (size_t i = 0; i < description.objects.size(); ++i) (*sink)(std::move(description.objects[i]), i);
+            description.objects.clear();
+        }
+        return description;
+    }  // the Cornell course's XML scenes
     // Mapped, not copied; devices, fifos and other files that are not regular files are refused
     // before a byte is read (/dev/urandom would never end).
     const MappedTextFile file(path, limits::max_scene_file_bytes, "scene file");
-    return parse_scene_text(file.text(), path);
+    return parse_scene_text(file.text(), path, sink);
 }
 
 }  // namespace whitted

@@ -10,6 +10,7 @@
 #include "whitted/scene/description.h"
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -43,8 +44,19 @@ struct Light {
     Color intensity;
 };
 
+/// An object-to-world transform held by reference, null for the identity: most spheres and boxes
+/// have none, and a scene of a million spheres should not carry a million 200-byte identities
+/// (docs/performance.md, "Reading large scenes").
+using SharedTransform = std::shared_ptr<const Transform>;
+
+/// The transform a SharedTransform stands for.
+inline const Transform& transform_of(const SharedTransform& transform) {
+    static const Transform identity;
+    return transform ? *transform : identity;
+}
+
 struct Sphere {
-    Transform object_to_world;  ///< identity for most spheres
+    SharedTransform object_to_world;  ///< null (the identity) for most spheres
     Vec3 center;
     double radius = 1;
     uint32_t material = 0;
@@ -52,7 +64,7 @@ struct Sphere {
 };
 
 struct Box {
-    Transform object_to_world;
+    SharedTransform object_to_world;  ///< null: the identity
     Vec3 min, max;
     uint32_t material = 0;
     uint32_t object = 0;  ///< Scene::objects index + 1
@@ -105,6 +117,7 @@ struct Scene {
     std::vector<Box> boxes;
     std::vector<Plane> planes;
     std::vector<TriangleMesh> meshes;
+    std::vector<std::string> mesh_files;  ///< the mesh files read, as resolved paths
 
     size_t triangle_count() const;
 };
@@ -112,6 +125,15 @@ struct Scene {
 /// Checks every value of a description and builds the scene (loading mesh files). Throws
 /// InputError naming file:line:col for anything out of range.
 Scene validate_scene(const SceneDescription& description);
+
+/// parse_scene_file and validate_scene in one pass: each top-level object is validated as soon as
+/// it is parsed and its description let go, so that a file of a million spheres never holds a
+/// million descriptions (docs/performance.md, "Reading large scenes"). The same checks, the same
+/// mistake reported, the same Scene as validate_scene(parse_scene_file(path)). `settings`, if
+/// given, receives the description without its objects.
+Scene load_scene_file(const std::string& path, SceneDescription* settings = nullptr);
+/// Same, from text already in memory (as parse_scene_text).
+Scene load_scene_text(std::string_view text, const std::string& path, SceneDescription* settings = nullptr);
 
 /// Builds the camera's basis from its description (also used by the converters' tests).
 Camera make_camera(const CameraDescription& camera, int width, int height);

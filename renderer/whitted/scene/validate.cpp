@@ -9,8 +9,11 @@
 #include "whitted/scene/text_checks.h"
 
 #include <cmath>
+#include <exception>
 #include <filesystem>
+#include <memory>
 #include <numbers>
+#include <string_view>
 #include <unordered_map>
 
 namespace whitted {
@@ -51,43 +54,106 @@ Material make_material(const MaterialDescription& d, const std::string& what) {
     return material;
 }
 
+/// Builds the scene's objects one top-level object at a time, so that load_scene_file can
+/// validate each as soon as it is parsed and let its description go. The named materials may
+/// come later in the file than the objects using them, so objects first get provisional
+/// material numbers (a name's number in order of first use, or an inline/MTL material's number
+/// with `provisional_own` set); finish() validates the named materials, places them first (named
+/// in file order, then inline and MTL ones as met, as Scene::materials says) and renumbers.
+/// Mistakes are reported in the order validate_scene always used: the named materials first, then
+/// the objects in file order, each object's own checks in the order add_object makes them.
 class SceneBuilder {
 public:
-    SceneBuilder(const SceneDescription& description, Scene& scene) : m_description(description), m_scene(scene) {
-        for (const auto& material : description.materials) {
-            m_material_index[material.name] = static_cast<uint32_t>(scene.materials.size());
-            scene.materials.push_back(make_material(material, "materials." + material.name));
-            scene.material_names.push_back(material.name);
-            m_material_names.push_back(material.name);
+    explicit SceneBuilder(Scene& scene) : m_scene(scene) {}
+
+    /// One item of the scene's `objects`. Its first mistake is kept for finish(), and the rest
+    /// are then ignored: nothing after a mistake can change which mistake is reported.
+    void add_top_level(const ObjectDescription& object) {
+        if (m_error) return;
+        try {
+            add_object(object, Transform());
+        } catch (const InputError&) {
+            m_error = std::current_exception();
+            m_error_step = m_step;
         }
     }
 
-    void add_objects(const std::vector<ObjectDescription>& objects, const Transform& parent) {
-        for (const auto& object : objects) add_object(object, parent);
+    void finish(const std::vector<MaterialDescription>& named) {
+        std::unordered_map<std::string_view, uint32_t> index;
+        std::vector<std::string> names;
+        for (const auto& material : named) {
+            index.emplace(material.name, static_cast<uint32_t>(m_scene.materials.size()));
+            m_scene.materials.push_back(make_material(material, "materials." + material.name));
+            m_scene.material_names.push_back(material.name);
+            names.push_back(material.name);
+        }
+        std::vector<uint32_t> final_index(m_uses.size());
+        for (size_t i = 0; i < m_uses.size(); ++i) {
+            const NameUse& use = m_uses[i];
+            const auto it = index.find(use.name);
+            if (it != index.end()) {
+                final_index[i] = it->second;
+                continue;
+            }
+            if (m_error && m_error_step < use.step) break;  // an earlier mistake is reported below
+            std::string known;
+            for (const auto& name : names) known += (known.empty() ? "" : ", ") + name;
+            fail(use.where, use.kind + ": unknown material '" + printable(use.name) + "'" +
+                                did_you_mean(use.name, names) +
+                                (known.empty() ? "; the scene defines no materials" : "; defined: " + known));
+        }
+        if (m_error) std::rethrow_exception(m_error);
+        const uint32_t own_base = static_cast<uint32_t>(m_scene.materials.size());
+        for (size_t i = 0; i < m_own.size(); ++i) {
+            m_scene.materials.push_back(m_own[i]);
+            m_scene.material_names.push_back(std::move(m_own_names[i]));
+        }
+        const auto renumber = [&](uint32_t& material) {
+            material = material & provisional_own ? own_base + (material & ~provisional_own) : final_index[material];
+        };
+        for (Sphere& sphere : m_scene.spheres) renumber(sphere.material);
+        for (Box& box : m_scene.boxes) renumber(box.material);
+        for (Plane& plane : m_scene.planes) renumber(plane.material);
+        for (TriangleMesh& mesh : m_scene.meshes) {
+            // With MTL materials per triangle, `material` is unused (left 0, never provisional).
+            if (mesh.triangle_materials.empty()) renumber(mesh.material);
+            for (uint32_t& material : mesh.triangle_materials) renumber(material);
+        }
     }
 
 private:
+    static constexpr uint32_t provisional_own = 0x80000000u;
+
+    /// A material name as first used, and where: the place an unknown name is reported.
+    struct NameUse {
+        std::string name;
+        SourceLocation where;
+        std::string kind;
+        uint64_t step = 0;
+    };
+
+    uint32_t add_own_material(Material material, std::string name) {
+        m_own.push_back(material);
+        m_own_names.push_back(std::move(name));
+        return provisional_own | static_cast<uint32_t>(m_own.size() - 1);
+    }
+
     uint32_t resolve_material(const ObjectDescription& object) {
-        const std::string kind = to_string(object.type);
-        if (!object.material) fail(object.where, kind + ": missing required key 'material'");
+        ++m_step;
+        const char* kind = to_string(object.type);
+        if (!object.material) fail(object.where, std::string(kind) + ": missing required key 'material'");
         const MaterialReference& reference = *object.material;
-        if (reference.inline_) {
-            m_scene.materials.push_back(make_material(*reference.inline_, kind + ".material"));
-            m_scene.material_names.push_back("");
-            return static_cast<uint32_t>(m_scene.materials.size() - 1);
-        }
-        const auto it = m_material_index.find(reference.name);
-        if (it == m_material_index.end()) {
-            std::string known;
-            for (const auto& name : m_material_names) known += (known.empty() ? "" : ", ") + name;
-            fail(reference.where, kind + ": unknown material '" + printable(reference.name) + "'" +
-                                      did_you_mean(reference.name, m_material_names) +
-                                      (known.empty() ? "; the scene defines no materials" : "; defined: " + known));
-        }
-        return it->second;
+        if (reference.inline_)
+            return add_own_material(make_material(*reference.inline_, std::string(kind) + ".material"), "");
+        // Most scenes name a handful of materials; the last one used is usually used again.
+        if (m_last_use < m_uses.size() && m_uses[m_last_use].name == reference.name) return m_last_use;
+        const auto [it, added] = m_use_index.try_emplace(reference.name, static_cast<uint32_t>(m_uses.size()));
+        if (added) m_uses.push_back({reference.name, reference.where, kind, m_step});
+        return m_last_use = it->second;
     }
 
     void add_object(const ObjectDescription& object, const Transform& parent) {
+        ++m_step;
         for (const TransformStep& step : object.transform) check_step(step);
         const Transform to_world = make_transform(object.transform).then(parent);
         if (!(std::fabs(to_world.determinant()) > 1e-300))
@@ -96,8 +162,8 @@ private:
         switch (object.type) {
             case ObjectType::sphere: {
                 if (!(object.radius.value > 0)) fail(object.radius.where, "sphere.radius must be > 0");
-                m_scene.spheres.push_back(
-                    {to_world, object.center.value, object.radius.value, resolve_material(object), add_id(object)});
+                m_scene.spheres.push_back({shared(to_world), object.center.value, object.radius.value,
+                                           resolve_material(object), add_id(object)});
                 break;
             }
             case ObjectType::plane: {
@@ -112,7 +178,7 @@ private:
                 if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z))
                     fail(object.max.where, "box: min must be less than max on every axis (min " + format(lo) +
                                                ", max " + format(hi) + ")");
-                m_scene.boxes.push_back({to_world, lo, hi, resolve_material(object), add_id(object)});
+                m_scene.boxes.push_back({shared(to_world), lo, hi, resolve_material(object), add_id(object)});
                 break;
             }
             case ObjectType::triangle: {
@@ -131,7 +197,7 @@ private:
                     add_inline_mesh(object, to_world);
                 break;
             case ObjectType::group:
-                add_objects(object.children, to_world);
+                for (const auto& child : object.children) add_object(child, to_world);
                 break;
         }
     }
@@ -170,6 +236,7 @@ private:
             return InputError(e.where(), e.message() + " (mesh loaded at " + object.file.where.str() + ")");
         };
         MeshData data;
+        m_scene.mesh_files.push_back(object.file_path);
         try {
             // With the object's own material the MTL files are not needed (nor read).
             data = is_msh_file(object.file_path)
@@ -185,11 +252,11 @@ private:
         } else {
             std::vector<uint32_t> mtl_index;
             for (size_t i = 0; i < data.materials.size(); ++i) {
-                mtl_index.push_back(static_cast<uint32_t>(m_scene.materials.size()));
                 try {
-                    m_scene.materials.push_back(make_material(
-                        data.materials[i], object.file_path + ": material '" + data.materials[i].name + "'"));
-                    m_scene.material_names.push_back(data.materials[i].name);
+                    mtl_index.push_back(add_own_material(
+                        make_material(data.materials[i],
+                                      object.file_path + ": material '" + data.materials[i].name + "'"),
+                        data.materials[i].name));
                 } catch (const InputError& e) {
                     throw with_reference(e);
                 }
@@ -270,10 +337,20 @@ private:
         return buffer;
     }
 
-    const SceneDescription& m_description;
+    /// Null for the identity, so that the shapes take their untransformed path.
+    static SharedTransform shared(const Transform& to_world) {
+        return to_world.is_identity() ? nullptr : std::make_shared<const Transform>(to_world);
+    }
+
     Scene& m_scene;
-    std::unordered_map<std::string, uint32_t> m_material_index;
-    std::vector<std::string> m_material_names;
+    std::vector<NameUse> m_uses;  ///< material names in order of first use
+    std::unordered_map<std::string, uint32_t> m_use_index;
+    uint32_t m_last_use = UINT32_MAX;
+    std::vector<Material> m_own;  ///< inline and MTL materials, as met
+    std::vector<std::string> m_own_names;
+    uint64_t m_step = 0;  ///< objects and material references seen: orders mistakes as met
+    std::exception_ptr m_error;
+    uint64_t m_error_step = 0;
 };
 
 }  // namespace
@@ -376,8 +453,10 @@ Camera make_camera(const CameraDescription& d, int width, int height) {
     return camera;
 }
 
-Scene validate_scene(const SceneDescription& d) {
-    Scene scene;
+namespace {
+
+/// Everything but the objects: image, render settings, camera and lights.
+void validate_settings(const SceneDescription& d, Scene& scene) {
     scene.path = d.path;
     const auto& image = d.image;
     if (image.width.value < 1) fail(image.width.where, "image.width must be at least 1");
@@ -429,13 +508,58 @@ Scene validate_scene(const SceneDescription& d) {
         }
         scene.lights.push_back(out);
     }
+}
 
-    SceneBuilder builder(d, scene);
-    builder.add_objects(d.objects, Transform());
+void check_triangle_limit(const Scene& scene) {
     if (static_cast<int64_t>(scene.triangle_count()) > limits::max_triangles)
-        throw InputError({d.path}, "the scene has " + std::to_string(scene.triangle_count()) +
-                                       " triangles; the limit is " + std::to_string(limits::max_triangles));
+        throw InputError({scene.path}, "the scene has " + std::to_string(scene.triangle_count()) +
+                                           " triangles; the limit is " + std::to_string(limits::max_triangles));
+}
+
+}  // namespace
+
+Scene validate_scene(const SceneDescription& d) {
+    Scene scene;
+    SceneBuilder builder(scene);
+    for (const ObjectDescription& object : d.objects) builder.add_top_level(object);
+    validate_settings(d, scene);
+    builder.finish(d.materials);
+    check_triangle_limit(scene);
     return scene;
+}
+
+namespace {
+
+/// The one pass of load_scene_file/_text: `parse` reads the file, handing each object to the sink.
+template <class Parse>
+Scene load_scene(const Parse& parse, SceneDescription* settings) {
+    Scene scene;
+    auto builder = std::make_unique<SceneBuilder>(scene);
+    bool started = false;
+    const ObjectSink sink = [&](ObjectDescription&& object, size_t index) {
+        if (index == 0 && started) {  // read again from the start (description.h)
+            scene = Scene();
+            builder = std::make_unique<SceneBuilder>(scene);
+        }
+        started = true;
+        builder->add_top_level(object);
+    };
+    SceneDescription d = parse(&sink);
+    validate_settings(d, scene);
+    builder->finish(d.materials);
+    check_triangle_limit(scene);
+    if (settings) *settings = std::move(d);
+    return scene;
+}
+
+}  // namespace
+
+Scene load_scene_file(const std::string& path, SceneDescription* settings) {
+    return load_scene([&](const ObjectSink* sink) { return parse_scene_file(path, sink); }, settings);
+}
+
+Scene load_scene_text(std::string_view text, const std::string& path, SceneDescription* settings) {
+    return load_scene([&](const ObjectSink* sink) { return parse_scene_text(text, path, sink); }, settings);
 }
 
 }  // namespace whitted
