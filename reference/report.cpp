@@ -1,19 +1,29 @@
 // SPDX-License-Identifier: MIT
 // The report of `whitted check --report DIR`: the two images, a difference heat map, the
-// figures as JSON and one HTML page that shows them side by side. The page needs nothing but
-// the files next to it (no scripts, no web fonts), so a CI artefact can be opened anywhere.
+// figures as JSON and one HTML page to explore them (docs/validation.md, "The report"). The page
+// needs nothing but the files next to it (no server, no network, no web fonts), so a CI
+// artefact opens from file:// anywhere. From file:// a browser lets a page neither fetch its
+// sibling files nor read back the pixels of an <img> it drew, so the values its pixel probe
+// shows come from report-data.js, loaded by a <script> tag: the compared float values
+// themselves, not the PNGs.
 
 #include "reference/check.h"
 
 #include "whitted/output/atomic_files.h"
 #include "whitted/output/image_output.h"
 
+#include "report_viewer_js.h"
+
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
+#include <zlib.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <stdexcept>
@@ -116,6 +126,79 @@ nlohmann::json rgb_json(const float* v) {
     return nlohmann::json::array({double(v[0]), double(v[1]), double(v[2])});
 }
 
+/// Standard base64 (RFC 4648, with padding), what the page's atob() reads.
+std::string base64(const std::vector<unsigned char>& bytes) {
+    static const char alphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    out.reserve((bytes.size() + 2) / 3 * 4);
+    for (size_t i = 0; i < bytes.size(); i += 3) {
+        const uint32_t n = uint32_t(bytes[i]) << 16 | (i + 1 < bytes.size() ? uint32_t(bytes[i + 1]) << 8 : 0) |
+                           (i + 2 < bytes.size() ? uint32_t(bytes[i + 2]) : 0);
+        out += alphabet[(n >> 18) & 63];
+        out += alphabet[(n >> 12) & 63];
+        out += i + 1 < bytes.size() ? alphabet[(n >> 6) & 63] : '=';
+        out += i + 2 < bytes.size() ? alphabet[n & 63] : '=';
+    }
+    return out;
+}
+
+/// The floats exactly as compared, for the page to decode (report_viewer.js, decode_floats):
+/// IEEE binary32, little-endian, the bytes regrouped into four planes (every value's lowest
+/// byte first, then every second byte, ...: neighbouring pixels then share long runs in the
+/// high planes, which deflate roughly halves), deflated in zlib format (what the browser's
+/// DecompressionStream("deflate") reads), base64-encoded.
+std::string encode_floats(const std::vector<float>& values) {
+    const size_t n = values.size();
+    std::vector<unsigned char> planes(4 * n);
+    for (size_t i = 0; i < n; ++i) {
+        const uint32_t bits = std::bit_cast<uint32_t>(values[i]);
+        for (size_t k = 0; k < 4; ++k) planes[k * n + i] = static_cast<unsigned char>(bits >> (8 * k));
+    }
+    uLongf size = compressBound(uLong(planes.size()));
+    std::vector<unsigned char> deflated(size);
+    if (compress2(deflated.data(), &size, planes.data(), uLong(planes.size()), 6) != Z_OK)
+        throw std::runtime_error("cannot compress the report's pixel data");
+    deflated.resize(size);
+    return base64(deflated);
+}
+
+/// report-data.js: what the page's viewer shows and probes, as one JavaScript assignment. The
+/// images are those compared (at the compared exposure); the colour render layers (when the
+/// check rendered with --layers) are multiplied by the same exposure, so that they add up to
+/// Whitted's compared image as the EXR's layers add up to its R, G, B.
+std::string report_data_js(const std::string& scene_path, const Image& ours, const Image& theirs, const CheckResult& r,
+                           const CheckOptions& options) {
+    const ImageComparison& c = r.comparison;
+    nlohmann::json j;
+    j["format"] = 1;
+    j["scene"] = scene_path;
+    j["passed"] = r.passed;
+    j["verdict"] = verdict_line(scene_path, r, options);
+    j["width"] = c.width;
+    j["height"] = c.height;
+    j["exposure"] = r.exposure;
+    j["tolerance_codes"] = options.rule.tolerance * 65535;
+    j["encoding"] =
+        "float32 little-endian, byte planes, zlib deflate, base64; values as compared (x 65535 = 16-bit codes)";
+    j["whitted"] = encode_floats(ours.rgb);
+    j["povray"] = encode_floats(theirs.rgb);
+    nlohmann::json layers = nlohmann::json::array();
+    for (const ImageLayer& layer : ours.layers) {
+        if (layer.data || layer.channels.size() != 3) continue;  // normals, depth, ids: not terms of L
+        std::vector<float> exposed = layer.values;
+        if (r.exposure != 1)
+            for (float& v : exposed) v = float(double(v) * r.exposure);  // a power of two: exact
+        layers.push_back({{"name", layer.name}, {"values", encode_floats(exposed)}});
+    }
+    j["layers"] = layers;
+    nlohmann::json worst = nlohmann::json::array();
+    for (const PixelError& w : c.worst) worst.push_back({{"x", w.x}, {"y", w.y}, {"error_codes", w.error * 65535}});
+    j["worst_pixels"] = worst;
+    return "// Written by whitted check: the data report.html shows (docs/validation.md, \"The report\").\n"
+           "window.WHITTED_REPORT = " +
+           j.dump() + ";\n";
+}
+
 nlohmann::json metrics_json(const std::string& scene_path, const CheckResult& r, const CheckOptions& options) {
     const ImageComparison& c = r.comparison;
     nlohmann::json j;
@@ -161,9 +244,16 @@ nlohmann::json metrics_json(const std::string& scene_path, const CheckResult& r,
     j["povray_seconds"] = r.povray_seconds;
     j["povray_runs"] = r.povray_runs;
     j["povray_program"] = r.povray_program;
-    j["files"] = {{"pov", r.pov_file},         {"ini", r.ini_file},          {"povray_output", r.povray_image},
-                  {"whitted_exr", "ours.exr"}, {"povray_exr", "povray.exr"}, {"difference_exr", "diff.exr"},
-                  {"whitted_png", "ours.png"}, {"povray_png", "povray.png"}, {"heat_map_png", "diff.png"}};
+    j["files"] = {{"pov", r.pov_file},
+                  {"ini", r.ini_file},
+                  {"povray_output", r.povray_image},
+                  {"whitted_exr", "ours.exr"},
+                  {"povray_exr", "povray.exr"},
+                  {"difference_exr", "diff.exr"},
+                  {"whitted_png", "ours.png"},
+                  {"povray_png", "povray.png"},
+                  {"heat_map_png", "diff.png"},
+                  {"report_data_js", "report-data.js"}};
     return j;
 }
 
@@ -188,6 +278,51 @@ std::string figure(const std::string& file, const std::string& caption, const Im
         "</div><figcaption>{cap}</figcaption></figure>\n",
         fmt::arg("w", c.width * scale), fmt::arg("h", c.height * scale), fmt::arg("f", file), fmt::arg("cap", caption),
         fmt::arg("b", boxes));
+}
+
+/// The interactive viewer: one canvas showing two of Whitted / POV-Ray / difference split by a
+/// wipe, zoomed by whole factors; a pixel probe; the difference's threshold. Filled in by
+/// report_viewer.js from report-data.js; without scripts the static images below remain.
+std::string explore_section(const ImageComparison& c, double tolerance_codes) {
+    const auto source_options = [](const char* selected) {
+        std::string o;
+        for (const auto& [value, label] :
+             {std::pair{"whitted", "Whitted"}, {"povray", "POV-Ray"}, {"diff", "difference"}})
+            o += fmt::format("<option value=\"{}\"{}>{}</option>", value,
+                             std::string(value) == selected ? " selected" : "", label);
+        return o;
+    };
+    std::string h = "<h2>Explore</h2>\n<div id=\"viewer\" hidden>\n<div class=\"controls\">\n";
+    h += "<label>left <select id=\"left\">" + source_options("whitted") + "</select></label>\n";
+    h += fmt::format(
+        "<label>wipe <input id=\"wipe\" type=\"range\" min=\"0\" max=\"{0}\" step=\"1\" value=\"{1}\"> "
+        "<output id=\"wipe-value\">{1}</output></label>\n",
+        c.width, c.width / 2);
+    h += "<label>right <select id=\"right\">" + source_options("povray") + "</select></label>\n";
+    h += "<span class=\"zoom\">zoom <button id=\"zoom-out\" type=\"button\" title=\"zoom out (-)\">&minus;</button>"
+         "<output id=\"zoom-value\">1&times;</output><button id=\"zoom-in\" type=\"button\" title=\"zoom in "
+         "(+)\">+</button><button id=\"zoom-fit\" type=\"button\" title=\"fit (0)\">fit</button></span>\n";
+    h += fmt::format(
+        "<label>threshold <input id=\"threshold\" type=\"range\" min=\"0\" max=\"{0:g}\" step=\"any\" "
+        "value=\"{1:g}\"> <input id=\"threshold-value\" type=\"number\" min=\"0\" step=\"any\" value=\"{1:g}\"> "
+        "codes</label> <span id=\"above\"></span>\n",
+        std::max(8 * tolerance_codes, 16.0), tolerance_codes);
+    h += "</div>\n<div class=\"stage\"><canvas id=\"view\" tabindex=\"0\" width=\"640\" height=\"480\" "
+         "aria-label=\"image viewer: drag to pan, wheel to zoom, click to probe a pixel\"></canvas>\n"
+         "<div id=\"probe\"><h3>Pixel probe</h3>\n"
+         "<p><label>x <input id=\"probe-x\" type=\"number\" min=\"0\" step=\"1\"></label> "
+         "<label>y <input id=\"probe-y\" type=\"number\" min=\"0\" step=\"1\"></label></p>\n"
+         "<div id=\"probe-values\"></div></div></div>\n";
+    h += "<p class=\"help\">Drag to pan, mouse wheel or <kbd>+</kbd>/<kbd>-</kbd> to zoom (whole factors, so every "
+         "pixel is a square of equal size), <kbd>0</kbd> to fit; click a pixel to probe it, or move the probe with "
+         "the arrow keys (with <kbd>Shift</kbd>: pan); <kbd>[</kbd>/<kbd>]</kbd> move the wipe, <kbd>1</kbd> "
+         "Whitted | POV-Ray, <kbd>2</kbd> Whitted | difference, <kbd>3</kbd> POV-Ray | difference. Values are those "
+         "compared, in 16-bit codes (× 65535), linear, at the compared exposure; the images are shown with the "
+         "sRGB curve, as ours.png and povray.png. The difference colours pixels by their largest channel "
+         "difference against the threshold as the heat map below does against the tolerance.</p>\n</div>\n";
+    h +=
+        "<p id=\"viewer-missing\">The viewer needs JavaScript and <code>report-data.js</code> next to this page.</p>\n";
+    return h;
 }
 
 std::string report_html(const std::string& dir, const std::string& scene_path, const CheckResult& r,
@@ -231,6 +366,14 @@ th { background: #f3f3f3; text-align: left; }
 .legend-labels { display: flex; justify-content: space-between; width: 322px; font-size: .8em; }
 pre { background: #f6f8fa; padding: .6em; overflow-x: auto; }
 code { font-size: .95em; }
+.controls { display: flex; flex-wrap: wrap; gap: .4em 1.2em; align-items: center; margin-bottom: .5em; }
+.controls input[type=number] { width: 5em; }
+.stage { display: flex; flex-wrap: wrap; gap: 1.2em; align-items: flex-start; }
+#view { image-rendering: pixelated; background: #777; cursor: crosshair; outline: 1px solid #999; }
+#probe { flex: 1 1 380px; min-width: 0; max-width: 520px; } #probe h3 { font-size: 1em; margin: 0 0 .3em; }
+#probe input { width: 5em; } #probe td.within { color: #1a7f37; } #probe td.beyond { color: #cf222e; font-weight: bold; }
+.help { font-size: .9em; color: #444; max-width: 1100px; }
+kbd { border: 1px solid #bbb; border-radius: 3px; padding: 0 .25em; font-size: .9em; background: #f6f6f6; }
 </style>
 </head>
 <body>
@@ -250,6 +393,7 @@ code { font-size: .95em; }
              "href=\"povray.exr\">povray.exr</a> hold them as they are.</p>\n</body>\n</html>\n";
         return h;
     }
+    h += explore_section(c, tolerance_codes);
     h += "<h2>Images</h2>\n<div class=\"row\">\n";
     h += figure("ours.png", "Whitted (display sRGB of the linear image)", c, scale);
     h += figure("povray.png", "POV-Ray 3.7 (same display transform)", c, scale);
@@ -301,7 +445,9 @@ code { font-size: .95em; }
          "<th>POV-Ray R</th><th>G</th><th>B</th></tr>\n";
     for (size_t i = 0; i < c.worst.size(); ++i) {
         const PixelError& w = c.worst[i];
-        h += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td>", i + 1, w.x, w.y, format_codes(w.error)) +
+        // data-x, data-y: a click probes the pixel in the viewer above.
+        h += fmt::format("<tr data-x=\"{1}\" data-y=\"{2}\"><td>{0}</td><td>{1}</td><td>{2}</td><td>{3}</td>", i + 1,
+                         w.x, w.y, format_codes(w.error)) +
              code_cells(w.ours) + code_cells(w.theirs) + "</tr>\n";
     }
     h += "</table>\n";
@@ -316,7 +462,8 @@ code { font-size: .95em; }
         {"scene.pov", "the converted scene"},
         {"scene.ini", "POV-Ray's options (size, no antialiasing, 16-bit linear PNG)"},
         {"povray.log", "what POV-Ray printed"},
-        {"metrics.json", "the figures above, machine-readable"}};
+        {"metrics.json", "the figures above, machine-readable"},
+        {"report-data.js", "the compared values (and colour render layers) the viewer above shows and probes"}};
     for (const auto& [file, what] : files)
         h += fmt::format("<li><a href=\"{0}\"><code>{0}</code></a>: {1}</li>\n", file, what);
     h += "</ul>\n";
@@ -335,7 +482,9 @@ code { font-size: .95em; }
                                  options.rule.required_fraction, options.rule.max_error * 65535) +
                      "\n");
     h += "</pre>\n<p>See <code>docs/validation.md</code> for the mapping, the conventions and the tolerance.</p>\n";
-    h += "</body>\n</html>\n";
+    h += "<script src=\"report-data.js\"></script>\n<script>\n";
+    h += report_viewer_js;
+    h += "</script>\n</body>\n</html>\n";
     return h;
 }
 
@@ -373,7 +522,12 @@ void write_report(const std::string& dir, const std::string& scene_path, const I
 
     const std::string metrics = metrics_json(scene_path, result, options).dump(2) + "\n";
     const std::string html = report_html(dir, scene_path, result, options);
-    write_files_atomically({{d / "metrics.json", metrics}, {d / "report.html", html}});
+    if (result.comparison.pixels > 0)
+        write_files_atomically({{d / "metrics.json", metrics},
+                                {d / "report-data.js", report_data_js(scene_path, ours, theirs, result, options)},
+                                {d / "report.html", html}});
+    else
+        write_files_atomically({{d / "metrics.json", metrics}, {d / "report.html", html}});
 }
 
 }  // namespace whitted::reference

@@ -530,7 +530,8 @@ int main(int argc, char** argv) {
         "check", "Render a scene with Whitted and with POV-Ray (converted) and compare them pixel by pixel");
     check_cmd->add_option("scene", check_scene, "Scene file")->required()->check(CLI::ExistingFile);
     check_cmd->add_option("--report", check_options.report_dir,
-                          "Write images, a difference heat map, metrics.json and report.html into this directory");
+                          "Write images, a difference heat map, metrics.json and report.html (open it from the disk: "
+                          "wipe, zoom, pixel probe; docs/validation.md) into this directory");
     check_cmd->add_option("--tolerance", tolerance_codes, "Per-channel tolerance in 16-bit codes (1/65535)")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
