@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// The library's private side of whitted::api::Scene: the parsed description (the converters read
+// it) and the validated render Scene, with the BVH built once on demand. Only the library and the
+// `whitted` program (for --stats) include this; the public headers never do.
+
+#include "whitted/render/accelerator.h"
+#include "whitted/scene/description.h"
+#include "whitted/scene/scene.h"
+#include "whitted/whitted.h"
+
+#include <memory>
+#include <mutex>
+
+namespace whitted::api {
+
+struct Scene::Impl {
+    SceneDescription description;
+    whitted::Scene scene;
+    double parse_seconds = 0, validate_seconds = 0;  ///< load_scene_*: the two stages' wall time
+
+    /// The BVH, built by the first caller with `threads` build threads (0 = all cores) and kept.
+    /// Embree's instruction set comes from $WHITTED_EMBREE_ISA, as for `whitted render`.
+    const Accelerator& accelerator(int threads) const;
+
+private:
+    mutable std::mutex m_mutex;
+    mutable std::unique_ptr<Accelerator> m_accelerator;
+};
+
+}  // namespace whitted::api
