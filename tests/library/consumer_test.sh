@@ -50,4 +50,28 @@ c++ -O2 -o "$work/one_sphere_pc" "$source/examples/library/one_sphere.cpp" $(pkg
 echo "== the installed program and the plug-in beside the library"
 # Not the build tree's plug-in: the installed one, found from PREFIX/bin/whitted.
 "$prefix/bin/whitted" compare "$work/consumer.exr" "$work/consumer.exr" --tolerance 0 --max-error 0
+echo "== the installed Python module, and the plug-in found beside the installed libwhitted.so"
+python=${WHITTED_TEST_PYTHON:-/usr/bin/python3}
+if [ -x "$python" ] && [ -d "$prefix/lib/python3/dist-packages" ]; then
+  PYTHONPATH="$prefix/lib/python3/dist-packages" "$python" - "$prefix" "$work/consumer.exr" <<'PY'
+import sys
+import numpy as np
+import whitted
+prefix, exr = sys.argv[1], sys.argv[2]
+assert whitted.__file__.startswith(prefix), whitted.__file__
+scene = (whitted.SceneBuilder().image(65, 65).background([0.25, 0.5, 0.75])
+         .camera([0, 0, 5], [0, 0, 0], fov=30).ambient([0.5] * 3).point_light([0, 0, 5], [0.8] * 3)
+         .sphere([0, 0, 0], 1, {"ka": [0.2, 0.1, 0.05], "kd": [0.5, 0.25, 0.125]}).build())
+image = whitted.render(scene, threads=2)
+# The same scene as one_sphere's, so the same pixels as the EXR it wrote through the C++ API.
+whitted.write_image(image, exr + ".py.exr")
+maps = open("/proc/self/maps").read()
+assert prefix + "/lib/libwhitted.so" in maps, "libwhitted.so not loaded from the prefix"
+print("python: module and libwhitted.so from the prefix")
+PY
+  # Bit for bit, through the installed plug-in (whitted compare loads it).
+  "$prefix/bin/whitted" compare "$work/consumer.exr" "$work/consumer.exr.py.exr" --tolerance 0 --max-error 0
+else
+  echo "FAIL: no Python module installed under $prefix/lib/python3/dist-packages"; exit 1
+fi
 echo "PASS"
