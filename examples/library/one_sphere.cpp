@@ -4,8 +4,10 @@
 //   one_sphere [OUT.exr]   exits 0 when the pixel is right, 1 when it is not, 2 on an error.
 #include <whitted/whitted.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 int main(int argc, char** argv) {
     namespace api = whitted::api;
@@ -54,6 +56,21 @@ int main(int argc, char** argv) {
     for (int c = 0; c < 3; ++c) {
         ok = ok && std::fabs(centre[c] - want[c]) < 1e-6 && corner[c] == float(background[c]);
     }
+    // The same beauty into a buffer of the caller's; a wrong size is an error, not a crash.
+    std::vector<float> buffer(size_t(image.width) * size_t(image.height) * 3);
+    const api::Expected<api::RenderStats> into = api::render_into(*scene, buffer.data(), buffer.size(), options);
+    const bool same = into && buffer == image.rgb;
+    const bool refused = !api::render_into(*scene, buffer.data(), buffer.size() - 1, options);
+    // Cancelled before the first tile: no pixel rendered.
+    std::atomic<bool> stop{true};
+    api::RenderOptions cancelled = options;
+    cancelled.cancel = &stop;
+    const api::Expected<api::RenderResult> stopped = api::render(*scene, cancelled);
+    const bool cancel_ok = stopped && stopped->cancelled && stopped->stats.camera_rays == 0;
+    std::printf("render_into: %s; wrong size refused: %s; cancel: %s\n", same ? "same pixels" : "DIFFERENT",
+                refused ? "yes" : "NO", cancel_ok ? "ok" : "WRONG");
+    ok = ok && same && refused && cancel_ok;
+
     std::printf("centre pixel %.7f %.7f %.7f (lecture formula %.7f %.7f %.7f); corner %.7f %.7f %.7f: %s\n", centre[0],
                 centre[1], centre[2], want[0], want[1], want[2], corner[0], corner[1], corner[2], ok ? "ok" : "WRONG");
     return ok ? 0 : 1;

@@ -100,15 +100,16 @@ LayerSet layers_for(const Scene& scene, const RenderOptions& options) {
 
 whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& options, LayerSet layers) {
     const Accelerator& accelerator = scene.impl().accelerator(options.threads);
-    // The progress callback may cancel too: one flag for both, set by either.
-    std::atomic<bool> stop{false};
+    // The progress callback may cancel too: then one flag of ours for both, set by either (the
+    // caller's copied in by a watcher); without a callback the tiles check the caller's own.
+    std::atomic<bool> stop{options.cancel && options.cancel->load()};
     whitted::RenderOptions internal;
     internal.threads = options.threads;
     internal.layers = layers;
-    internal.cancel = &stop;
+    internal.cancel = options.on_progress || !options.cancel ? &stop : options.cancel;
     std::atomic<bool> watching{true};
     std::thread watcher;
-    if (options.cancel) {
+    if (options.cancel && options.on_progress) {
         // The caller's flag is copied into ours while the render runs (tiles check ours).
         watcher = std::thread([&] {
             while (watching.load()) {
@@ -348,8 +349,8 @@ Expected<RenderStats> render_into(const Scene& scene, float* rgb, size_t floats,
     const size_t needed = size_t(scene.width()) * size_t(scene.height()) * 3;
     if (!rgb || floats != needed)
         return plain_error("render_into: the buffer holds " + std::to_string(floats) + " floats; the " +
-                               std::to_string(scene.width()) + "x" + std::to_string(scene.height()) +
-                               " image needs " + std::to_string(needed) + " (width*height*3)",
+                               std::to_string(scene.width()) + "x" + std::to_string(scene.height()) + " image needs " +
+                               std::to_string(needed) + " (width*height*3)",
                            Error::Kind::bad_input);
     return guarded<RenderStats>("rendering " + scene.path(), [&]() -> Expected<RenderStats> {
         RenderOptions beauty = options;
@@ -402,8 +403,8 @@ Expected<CheckResult> check(const std::string& scene_path, const CheckOptions& o
         // `check` lives in the OpenImageIO plug-in (whitted/output/plugin.h), like the program's.
         // Its errors come back as values: exceptions do not cross into the plug-in's own copy
         // of the libraries. 0: done, 2: bad input, 1: failure.
-        using RunCheck = int (*)(const std::string&, const reference::CheckOptions&, reference::CheckResult&,
-                                 std::string&, Error&);
+        using RunCheck =
+            int (*)(const std::string&, const reference::CheckOptions&, reference::CheckResult&, std::string&, Error&);
         const auto run_check = reinterpret_cast<RunCheck>(image_io_plugin_symbol("whitted_api_check"));
         reference::CheckResult result;
         std::string verdict;

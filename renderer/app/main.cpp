@@ -3,6 +3,7 @@
 // libraries and turns their exceptions into messages and exit codes
 // (0 ok, 1 failure while rendering or checking, 2 bad input or usage, 130/143 interrupted).
 
+#include "api/api_internal.h"
 #include "converters/pov_writer.h"
 #include "converters/yaml_writer.h"
 #include "explain_command.h"
@@ -16,7 +17,6 @@
 #include "whitted/scene/description.h"
 #include "whitted/scene/scene.h"
 #include "whitted/whitted.h"
-#include "api/api_internal.h"
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>

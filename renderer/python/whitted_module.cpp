@@ -54,9 +54,9 @@ py::array_t<float> array_of(std::shared_ptr<whitted::Image> image, float* data, 
     auto* holder = new std::shared_ptr<whitted::Image>(std::move(image));
     py::capsule owner(holder, [](void* p) { delete static_cast<std::shared_ptr<whitted::Image>*>(p); });
     const auto h = py::ssize_t((*holder)->height), w = py::ssize_t((*holder)->width), c = py::ssize_t(channels);
-    return py::array_t<float>({h, w, c}, {py::ssize_t(sizeof(float)) * w * c, py::ssize_t(sizeof(float)) * c,
-                                         py::ssize_t(sizeof(float))},
-                              data, owner);
+    return py::array_t<float>(
+        {h, w, c}, {py::ssize_t(sizeof(float)) * w * c, py::ssize_t(sizeof(float)) * c, py::ssize_t(sizeof(float))},
+        data, owner);
 }
 
 /// api::render on a worker thread; the GIL is released meanwhile and this (calling) thread runs
@@ -157,8 +157,9 @@ api::Material material(const py::dict& m) {
 }  // namespace
 
 PYBIND11_MODULE(whitted, m) {
-    m.doc() = "Whitted: an offline ray tracer for the lecture shading model, checked against POV-Ray 3.7 "
-              "(docs/library.md)";
+    m.doc() =
+        "Whitted: an offline ray tracer for the lecture shading model, checked against POV-Ray 3.7 "
+        "(docs/library.md)";
     m.attr("__version__") = api::version();
     m.def("version", &api::version, "The library's version (the same as whitted.__version__).");
 
@@ -283,7 +284,9 @@ PYBIND11_MODULE(whitted, m) {
         .def(py::init<>())
         .def(
             "image",
-            [](api::SceneBuilder& b, int w, int h, int samples) -> api::SceneBuilder& { return b.image(w, h, samples); },
+            [](api::SceneBuilder& b, int w, int h, int samples) -> api::SceneBuilder& {
+                return b.image(w, h, samples);
+            },
             py::arg("width"), py::arg("height"), py::arg("samples") = 1, py::return_value_policy::reference_internal)
         .def(
             "background",
@@ -291,10 +294,8 @@ PYBIND11_MODULE(whitted, m) {
             py::return_value_policy::reference_internal)
         .def(
             "camera",
-            [](api::SceneBuilder& b, std::array<double, 3> eye, std::array<double, 3> look_at,
-               std::array<double, 3> up, double fov) -> api::SceneBuilder& {
-                return b.camera(vec(eye), vec(look_at), vec(up), fov);
-            },
+            [](api::SceneBuilder& b, std::array<double, 3> eye, std::array<double, 3> look_at, std::array<double, 3> up,
+               double fov) -> api::SceneBuilder& { return b.camera(vec(eye), vec(look_at), vec(up), fov); },
             py::arg("eye"), py::arg("look_at"), py::arg("up") = std::array<double, 3>{0, 1, 0}, py::arg("fov") = 45.0,
             py::return_value_policy::reference_internal)
         .def(
@@ -335,9 +336,10 @@ PYBIND11_MODULE(whitted, m) {
         .def(
             "triangle",
             [](api::SceneBuilder& b, std::array<double, 3> a, std::array<double, 3> b2, std::array<double, 3> c,
-               const py::dict& mat) -> api::SceneBuilder& { return b.triangle(vec(a), vec(b2), vec(c), material(mat)); },
-            py::arg("a"), py::arg("b"), py::arg("c"), py::arg("material"),
-            py::return_value_policy::reference_internal)
+               const py::dict& mat) -> api::SceneBuilder& {
+                return b.triangle(vec(a), vec(b2), vec(c), material(mat));
+            },
+            py::arg("a"), py::arg("b"), py::arg("c"), py::arg("material"), py::return_value_policy::reference_internal)
         .def(
             "build", [](const api::SceneBuilder& b) { return take(b.build()); },
             "Validate and return the Scene (raises whitted.Error naming '<SceneBuilder>:CALL').");

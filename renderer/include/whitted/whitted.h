@@ -70,7 +70,7 @@ private:
 template <class T>
 class Expected {
 public:
-    Expected(T value) : m_value(std::move(value)) {}  // NOLINT: implicit, like std::expected
+    Expected(T value) : m_value(std::move(value)) {}      // NOLINT: implicit, like std::expected
     Expected(Error error) : m_error(std::move(error)) {}  // NOLINT
 
     bool has_value() const { return m_value.has_value(); }
