@@ -6,9 +6,9 @@
 # and checks its centre pixel against the lecture's formula (exit 0 only when it is right).
 # Also: the installed `whitted` finds the plug-in next to libwhitted.so, and its EXR matches the
 # consumer's, which writes the same scene through api::write_image.
-# Usage: consumer_test.sh BUILD_DIR SOURCE_DIR
+# Usage: consumer_test.sh BUILD_DIR SOURCE_DIR [PYTHON_MODULE=ON|OFF]
 set -euo pipefail
-build=$1 source=$2
+build=$1 source=$2 python_module=${3:-ON}
 work="$build/library-test"
 rm -rf "$work"
 mkdir -p "$work"
@@ -52,7 +52,9 @@ echo "== the installed program and the plug-in beside the library"
 "$prefix/bin/whitted" compare "$work/consumer.exr" "$work/consumer.exr" --tolerance 0 --max-error 0
 echo "== the installed Python module, and the plug-in found beside the installed libwhitted.so"
 python=${WHITTED_TEST_PYTHON:-/usr/bin/python3}
-if [ -x "$python" ] && [ -d "$prefix/lib/python3/dist-packages" ]; then
+if [ "$python_module" = OFF ]; then
+  echo "(built with -DWHITTED_BUILD_PYTHON=OFF: no Python module to check)"
+elif [ -x "$python" ] && [ -d "$prefix/lib/python3/dist-packages" ]; then
   PYTHONPATH="$prefix/lib/python3/dist-packages" "$python" - "$prefix" "$work/consumer.exr" <<'PY'
 import sys
 import numpy as np
