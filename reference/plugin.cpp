@@ -6,6 +6,7 @@
 #include "reference/check.h"
 #include "reference/file_colour.h"
 #include "whitted/scene/source_location.h"
+#include "whitted/whitted.h"
 
 #include <OpenImageIO/imageio.h>
 
@@ -40,6 +41,35 @@ __attribute__((visibility("default"))) int whitted_run_check(const std::string& 
     } catch (const std::exception& e) {
         std::fprintf(stderr, "whitted: error: %s\n", e.what());
         return 2;
+    }
+}
+
+/// whitted::api::check (whitted/whitted.h): run_check with its result and verdict line handed
+/// back, and its errors as a value (exceptions stay on this side of dlopen). Returns 0 when the
+/// check ran (passed or not), 2 for bad input, 1 for a failure.
+__attribute__((visibility("default"))) int whitted_api_check(const std::string& scene_path,
+                                                             const whitted::reference::CheckOptions& options,
+                                                             whitted::reference::CheckResult& result,
+                                                             std::string& verdict, whitted::api::Error& error) {
+    try {
+        result = whitted::reference::run_check(scene_path, options);
+        verdict = whitted::reference::verdict_line(scene_path, result, options);
+        return 0;
+    } catch (const whitted::InputError& e) {
+        error.message = e.message();
+        error.file = e.where().file.str();
+        error.line = e.where().line;
+        error.column = e.where().column;
+        return 2;
+    } catch (const std::bad_alloc&) {
+        error.message = "out of memory while checking " + scene_path;
+        return 1;
+    } catch (const std::invalid_argument& e) {
+        error.message = e.what();
+        return 2;
+    } catch (const std::exception& e) {
+        error.message = e.what();
+        return 1;
     }
 }
 

@@ -3,6 +3,7 @@
 // libraries and turns their exceptions into messages and exit codes
 // (0 ok, 1 failure while rendering or checking, 2 bad input or usage, 130/143 interrupted).
 
+#include "api/api_internal.h"
 #include "converters/pov_writer.h"
 #include "converters/yaml_writer.h"
 #include "explain_command.h"
@@ -15,6 +16,7 @@
 #include "whitted/render/renderer.h"
 #include "whitted/scene/description.h"
 #include "whitted/scene/scene.h"
+#include "whitted/whitted.h"
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
@@ -31,6 +33,7 @@
 #include <filesystem>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 namespace {
@@ -174,13 +177,21 @@ private:
     std::chrono::steady_clock::time_point m_start = std::chrono::steady_clock::now(), m_last = m_start;
 };
 
+/// The API's error, printed as `whitted` always has; its exit status.
+int report(const api::Error& error) {
+    print_error(error.what());
+    return error.kind == api::Error::Kind::bad_input ? exit_bad_input : exit_failure;
+}
+
+/// `whitted render`: a user of the public API (whitted/whitted.h) for loading, rendering and
+/// writing; the usage checks before any work and --stats (which reads the BVH's figures through
+/// the private side of api::Scene) are the program's own.
 int run_render(const RenderArguments& args) {
     StageTimer timer;
-    Scene scene;
-    double read_seconds = 0;
     install_signal_handlers();
     OutputOptions output = output_options(args);
     LayerSet layers;
+    std::optional<api::Scene> loaded;
     try {
         // Usage first, in milliseconds: nothing here reads the scene.
         check_output_path(args.output);
@@ -190,20 +201,27 @@ int run_render(const RenderArguments& args) {
         }
         check_output_options(args.output, output);
         refuse_output_over(args.output, args.scene, "scene file");
-        // Parsed and validated in one pass (load_scene_file): a million objects are never all
-        // held as descriptions. `description` is the rest of the file, without the objects.
-        SceneDescription description;
-        scene = load_scene_file(args.scene, &description);
-        read_seconds = timer.lap();
+    } catch (const InputError& e) {
+        print_error(e.what());
+        return exit_bad_input;
+    } catch (const std::invalid_argument& e) {
+        print_error(e.what());
+        return exit_bad_input;
+    } catch (const std::exception& e) {  // e.g. a filesystem error
+        print_error(args.scene + ": " + e.what());
+        return exit_bad_input;
+    }
+    api::Expected<api::Scene> read = api::load_scene_file(args.scene);
+    if (!read) return report(read.error());
+    loaded.emplace(std::move(read).value());
+    const api::Scene::Impl& impl = loaded->impl();
+    const SceneDescription& description = impl.description;
+    const Scene& scene = impl.scene;
+    timer.lap();
+    try {
         if (args.layers.empty() && !description.layers.empty()) {
             // The scene's render.layers, unless --layers was given (--layers none turns them off).
-            std::vector<std::string> names;
-            for (const auto& layer : description.layers) names.push_back(layer.value);
-            try {
-                layers = parse_layers(names);
-            } catch (const std::invalid_argument&) {
-                layers = LayerSet();  // validate_scene names the bad entry's place below
-            }
+            layers = parse_layers(loaded->layers());  // validated with the scene: the names are known
             if (!layers.empty()) {
                 output.layers_from = "render.layers at " + description.layers.front().where.str();
                 check_output_options(args.output, output);
@@ -223,44 +241,56 @@ int run_render(const RenderArguments& args) {
     } catch (const std::invalid_argument& e) {
         print_error(e.what());
         return exit_bad_input;
-    } catch (const std::bad_alloc&) {
-        // A scene or mesh too large for this machine's memory: an error, never an abort.
-        print_error(args.scene + ": out of memory while reading the scene");
-        return exit_failure;
-    } catch (const std::exception& e) {  // e.g. a filesystem error while reading
+    } catch (const std::exception& e) {
         print_error(args.scene + ": " + e.what());
         return exit_bad_input;
     }
 
     try {
-        const Accelerator accelerator(scene, args.threads);
+        const Accelerator& accelerator = impl.accelerator(args.threads);  // api::render uses this one
         const double build_seconds = timer.lap();
-        RenderOptions options;
+        api::RenderOptions options;
         options.threads = args.threads;
-        options.layers = layers;
+        options.layers = args.layers;  // empty: the scene's render.layers, as above
         options.cancel = &g_cancel;
-        if (!args.quiet && ::isatty(STDERR_FILENO)) options.on_progress = draw_progress;
+        const bool progress_bar = !args.quiet && ::isatty(STDERR_FILENO);
+        if (progress_bar)
+            options.on_progress = [](const api::Progress& p) {
+                draw_progress({p.tiles_done, p.tiles_total, p.rays, p.seconds});
+                return true;
+            };
         g_exit_on_signal.store(false);  // from here on a signal cancels, and we clean up
-        RenderResult result;
+        api::Expected<api::RenderResult> rendered = api::Error{};
         {
             const CancelWatchdog watchdog;
-            result = render(scene, accelerator, options);
+            rendered = api::render(*loaded, options);
         }
-        if (options.on_progress) std::fputc('\n', stderr);
+        if (progress_bar) std::fputc('\n', stderr);
+        if (!rendered) return report(rendered.error());
+        const api::RenderResult& result = rendered.value();
         timer.lap();
 
         // The scene's file name only: a file sent on should not carry this machine's paths.
-        output.metadata = {
+        api::WriteOptions write;
+        write.half = output.half;
+        write.exr_compression = output.exr_compression;
+        write.bit_depth = output.bit_depth;
+        write.ocio_config = output.ocio_config;
+        write.display = output.display;
+        write.view = output.view;
+        const uint64_t rays = result.stats.camera_rays + result.stats.shadow_rays + result.stats.reflected_rays;
+        write.metadata = {
             {"whitted:scene", std::filesystem::path(args.scene).filename().string()},
             {"whitted:settings", fmt::format("{}x{}, {} sample(s)/pixel, max depth {}", scene.width, scene.height,
                                              scene.samples * scene.samples, scene.max_depth)},
-            {"whitted:render_seconds", fmt::format("{:.3f}", result.seconds)},
-            {"whitted:rays", std::to_string(result.rays.total())}};
+            {"whitted:render_seconds", fmt::format("{:.3f}", result.stats.seconds)},
+            {"whitted:rays", std::to_string(rays)}};
         if (result.cancelled) {
             const int signal = g_signal.load();
             if (args.partial) {
-                output.metadata.push_back({"whitted:partial", "true: interrupted; unfinished tiles are black"});
-                write_image(result.image, args.output, output);
+                write.metadata.push_back({"whitted:partial", "true: interrupted; unfinished tiles are black"});
+                if (const auto written = api::write_image(result.image, args.output, write); !written)
+                    return report(written.error());
                 std::fprintf(stderr, "whitted: interrupted; partial image (unfinished tiles black) written to %s\n",
                              args.output.c_str());
             } else {
@@ -269,7 +299,8 @@ int run_render(const RenderArguments& args) {
             }
             return 128 + (signal ? signal : SIGINT);
         }
-        write_image(result.image, args.output, output);
+        if (const auto written = api::write_image(result.image, args.output, write); !written)
+            return report(written.error());
         const double write_seconds = timer.lap();
         const double total = timer.total();
         if (args.stats)
@@ -278,9 +309,10 @@ int run_render(const RenderArguments& args) {
                 "whitted: stages: read (parse, validate, load meshes) %.3fs, build BVH %.3fs, render %.3fs, write %.3fs; "
                 "%zu triangles, %zu spheres, %zu boxes, %zu planes, %zu lights; BVH %.1f MB (%.1f MB while "
                 "building); Embree %s, %d-wide packets\n",
-                read_seconds, build_seconds, result.seconds, write_seconds, scene.triangle_count(),
-                scene.spheres.size(), scene.boxes.size(), scene.planes.size(), scene.lights.size(),
-                double(accelerator.embree_bytes()) / 1e6, double(accelerator.peak_embree_bytes()) / 1e6,
+                impl.read_seconds, build_seconds, result.stats.seconds, write_seconds,
+                scene.triangle_count(), scene.spheres.size(), scene.boxes.size(), scene.planes.size(),
+                scene.lights.size(), double(accelerator.embree_bytes()) / 1e6,
+                double(accelerator.peak_embree_bytes()) / 1e6,
                 accelerator.isa().empty() ? "(its choice)" : accelerator.isa().c_str(), accelerator.lane_width());
         if (!args.quiet)
             std::fprintf(stderr,
@@ -288,9 +320,9 @@ int run_render(const RenderArguments& args) {
                          "(camera %.2f, shadow %.2f, reflected %.2f), %.1f M rays/s -> %s\n",
                          scene.width, scene.height, scene.samples * scene.samples,
                          args.threads > 0 ? unsigned(args.threads) : std::thread::hardware_concurrency(),
-                         result.seconds, total, result.rays.total() / 1e6, result.rays.camera / 1e6,
-                         result.rays.shadow / 1e6, result.rays.reflected / 1e6,
-                         result.seconds > 0 ? result.rays.total() / result.seconds / 1e6 : 0.0, args.output.c_str());
+                         result.stats.seconds, total, rays / 1e6, result.stats.camera_rays / 1e6,
+                         result.stats.shadow_rays / 1e6, result.stats.reflected_rays / 1e6,
+                         result.stats.seconds > 0 ? rays / result.stats.seconds / 1e6 : 0.0, args.output.c_str());
         return exit_ok;
     } catch (const std::invalid_argument& e) {
         print_error(e.what());
@@ -407,7 +439,7 @@ int run_colour(bool list, const std::string& config, const std::string& write_co
 /// `whitted --version`: the program's version and, since it decides which of Embree's code
 /// paths run, the instruction sets Embree can use here and the one in use.
 std::string version_text() {
-    std::string text = "whitted 0.1.0";
+    std::string text = std::string("whitted ") + api::version();
     try {
         const std::string isa = embree_isa_from_environment();
         const EmbreeInfo info = embree_info(isa);

@@ -29,6 +29,9 @@ import yaml
 from PIL import Image, ImageCms
 
 whitted, examples = sys.argv[1], sys.argv[2]
+# The version is written once, in CMake; `whitted --version` reports it ("whitted X.Y.Z" first).
+software = "Whitted " + subprocess.run([whitted, "--version"], capture_output=True, text=True,
+                                       check=True).stdout.split()[1]
 failures = []
 env = dict(os.environ)
 env.pop("OCIO", None)
@@ -120,7 +123,7 @@ def check_icc(path, label, transfer, primaries, description):
 
 
 def check_common(label, keys, scene_name, display, view):
-    check(keys.get("Software") == "Whitted 0.1.0", f"{label}: Software is {keys.get('Software')!r}")
+    check(keys.get("Software") == software, f"{label}: Software is {keys.get('Software')!r}, expected {software!r}")
     check(keys.get("whitted:scene") == scene_name, f"{label}: whitted:scene is {keys.get('whitted:scene')!r}")
     check("x" in keys.get("whitted:settings", "") and "max depth" in keys.get("whitted:settings", ""),
           f"{label}: whitted:settings is {keys.get('whitted:settings')!r}")

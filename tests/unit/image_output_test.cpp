@@ -6,6 +6,7 @@
 #include "whitted/output/image_output.h"
 
 #include "test_support.h"
+#include "whitted/version.h"
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
@@ -126,7 +127,7 @@ TEST(ImageOutput, PngHoldsTheRoundedDisplayCodes) {
         EXPECT_EQ(spec.height, 2);
         EXPECT_EQ(spec.nchannels, 3);
         EXPECT_EQ(spec.format, bits == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
-        EXPECT_EQ(spec.get_string_attribute("Software"), "Whitted 0.1.0");
+        EXPECT_EQ(spec.get_string_attribute("Software"), "Whitted " WHITTED_VERSION_STRING);
         EXPECT_EQ(spec.get_string_attribute("whitted:scene"), "/tmp/sc\xc3\xa8ne.yaml");
         for (size_t i = 0; i < codes.size(); ++i)
             EXPECT_EQ(codes[i], expected_code(image.rgb[i], bits)) << bits << " bits, value " << image.rgb[i];

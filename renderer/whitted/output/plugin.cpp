@@ -20,6 +20,17 @@ void* load_plugin() {
     std::error_code error;
     const auto exe = std::filesystem::read_symlink("/proc/self/exe", error);
     if (!error) candidates.push_back(exe.parent_path().parent_path() / "lib");
+#ifdef WHITTED_INSTALL_LIBDIR
+    // An installed program: PREFIX/bin/whitted finds PREFIX/<libdir>/libwhitted_oiio.so.
+    if (!error) candidates.push_back(exe.parent_path().parent_path() / WHITTED_INSTALL_LIBDIR);
+#endif
+    // The library (libwhitted.so, the Python module) in a program that is not ours, e.g.
+    // /usr/bin/python3: the plug-in is installed (and built) beside libwhitted.so.
+    Dl_info self{};
+    if (dladdr(reinterpret_cast<void*>(&load_plugin), &self) && self.dli_fname) {
+        const auto object = std::filesystem::weakly_canonical(self.dli_fname, error);
+        if (!error) candidates.push_back(object.parent_path());
+    }
 #ifdef WHITTED_BUILD_PLUGIN_DIR
     candidates.emplace_back(WHITTED_BUILD_PLUGIN_DIR);
 #endif

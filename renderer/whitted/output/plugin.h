@@ -11,7 +11,9 @@ namespace whitted {
 /// small render's time; a render never loads it.
 ///
 /// Returns the address of `name` in the plug-in, loading it from $WHITTED_PLUGIN_DIR, else from
-/// ../lib beside the running program, else from the build tree. Throws std::runtime_error
+/// ../lib (and ../<install libdir>) beside the running program, else from the directory of the
+/// shared object holding this code (libwhitted.so, for a program that links the library), else
+/// from the build tree. Throws std::runtime_error
 /// saying where it looked when the plug-in cannot be loaded.
 void* image_io_plugin_symbol(const char* name);
 

@@ -5,6 +5,7 @@
 // camera ray's first hit, written as extra channels of the EXR (docs/layers.md).
 
 #include "whitted/core/vec3.h"
+#include "whitted/image.h"
 #include "whitted/render/shading.h"
 #include "whitted/scene/scene.h"
 
@@ -84,14 +85,7 @@ private:
     std::vector<PathLayers> m_lanes;
 };
 
-/// One layer of an image: `channels` floats per pixel, named as EXR readers expect
-/// (`diffuse.R`, `N.X`, `Z`, ...).
-struct ImageLayer {
-    std::string name;
-    std::vector<std::string> channels;  ///< full EXR channel names
-    bool data = false;                  ///< a data layer (normals, ids, ...): always 32-bit float
-    std::vector<float> values;          ///< channels.size() per pixel, rows from the top
-};
+// ImageLayer, one layer of an image, is public: whitted/image.h.
 
 /// The image layers of `selection` for `scene`, sized and zeroed (Z: +inf), in a fixed order.
 std::vector<ImageLayer> make_image_layers(const Scene& scene, LayerSet selection);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include "whitted/image.h"
 #include "whitted/render/accelerator.h"
 #include "whitted/render/layers.h"
 #include "whitted/render/shading.h"
@@ -12,13 +13,7 @@
 
 namespace whitted {
 
-/// A linear, scene-referred RGB image, rows from the top.
-struct Image {
-    int width = 0, height = 0;
-    std::vector<float> rgb;          ///< 3 floats per pixel: the beauty
-    std::vector<ImageLayer> layers;  ///< render layers, when asked for (docs/layers.md)
-    const float* pixel(int x, int y) const { return &rgb[3 * (size_t(y) * width + x)]; }
-};
+// Image, the film every part shares, is public: whitted/image.h.
 
 struct RenderProgress {
     size_t tiles_done = 0, tiles_total = 0;

@@ -1,0 +1,444 @@
+// SPDX-License-Identifier: MIT
+// The public API (whitted/whitted.h) over the private libraries: every exception of theirs is
+// turned into an Error value here, with the location an InputError carries.
+
+#include "api/api_internal.h"
+#include "converters/pov_writer.h"
+#include "reference/check.h"
+#include "whitted/output/image_output.h"
+#include "whitted/output/plugin.h"
+#include "whitted/render/layers.h"
+#include "whitted/render/renderer.h"
+
+#include <chrono>
+#include <cstring>
+#include <new>
+#include <stdexcept>
+#include <thread>
+
+namespace whitted::api {
+namespace {
+
+using clock = std::chrono::steady_clock;
+
+double seconds_since(clock::time_point start) {
+    return std::chrono::duration<double>(clock::now() - start).count();
+}
+
+Error input_error(const InputError& e) {
+    Error error;
+    error.message = e.message();
+    error.file = e.where().file.str();
+    error.line = e.where().line;
+    error.column = e.where().column;
+    return error;
+}
+
+Error plain_error(std::string message, Error::Kind kind, std::string file = {}) {
+    Error error;
+    error.message = std::move(message);
+    error.kind = kind;
+    error.file = std::move(file);
+    return error;
+}
+
+/// Runs `work`, turning what it throws into an Error: InputError and std::invalid_argument are the
+/// caller's input (bad_input), anything else a failure. `what` finishes "out of memory while ...".
+template <class T, class Work>
+Expected<T> guarded(const std::string& what, Work&& work) {
+    try {
+        return work();
+    } catch (const InputError& e) {
+        return input_error(e);
+    } catch (const std::invalid_argument& e) {
+        return plain_error(e.what(), Error::Kind::bad_input);
+    } catch (const std::bad_alloc&) {
+        return plain_error("out of memory while " + what, Error::Kind::failure);
+    } catch (const std::exception& e) {
+        return plain_error(e.what(), Error::Kind::failure);
+    }
+}
+
+/// `read` fills the description and the validated scene of a new Scene::Impl.
+Expected<Scene> load(const std::string& label, const std::function<void(Scene::Impl&)>& read) {
+    try {
+        auto impl = std::make_unique<Scene::Impl>();
+        const auto start = clock::now();
+        read(*impl);
+        impl->read_seconds = seconds_since(start);
+        return Scene(std::move(impl));
+    } catch (const InputError& e) {
+        return input_error(e);
+    } catch (const std::invalid_argument& e) {
+        return plain_error(e.what(), Error::Kind::bad_input);
+    } catch (const std::bad_alloc&) {
+        // A scene or mesh too large for this machine's memory: an error, never an abort.
+        return plain_error("out of memory while reading the scene", Error::Kind::failure, label);
+    } catch (const std::exception& e) {  // e.g. a filesystem error while reading
+        return plain_error(e.what(), Error::Kind::bad_input, label);
+    }
+}
+
+/// The layers a render computes: the options', else the scene's render.layers.
+LayerSet layers_for(const Scene& scene, const RenderOptions& options) {
+    const SceneDescription& description = scene.impl().description;
+    std::vector<std::string> names = options.layers;
+    if (names.empty())
+        for (const auto& layer : description.layers) names.push_back(layer.value);
+    const LayerSet layers = parse_layers(names);
+    // The colour layers split each hit's terms at weight 1; a glazed (fresnel_ior) material
+    // scales them by 1 − F, which the layers do not yet follow, so they would not add up.
+    if (!layers.empty())
+        for (const whitted::Material& material : scene.impl().scene.materials)
+            if (material.fresnel_r0 >= 0)
+                throw std::invalid_argument(
+                    "render layers are not available for scenes with a fresnel_ior (glazed) material yet");
+    return layers;
+}
+
+whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& options, LayerSet layers) {
+    const Accelerator& accelerator = scene.impl().accelerator(options.threads);
+    // The progress callback may cancel too: then one flag of ours for both, set by either (the
+    // caller's copied in by a watcher); without a callback the tiles check the caller's own.
+    std::atomic<bool> stop{options.cancel && options.cancel->load()};
+    whitted::RenderOptions internal;
+    internal.threads = options.threads;
+    internal.layers = layers;
+    internal.cancel = options.on_progress || !options.cancel ? &stop : options.cancel;
+    std::atomic<bool> watching{true};
+    std::thread watcher;
+    if (options.cancel && options.on_progress) {
+        // The caller's flag is copied into ours while the render runs (tiles check ours).
+        watcher = std::thread([&] {
+            while (watching.load()) {
+                if (options.cancel->load()) stop.store(true);
+                std::this_thread::sleep_for(std::chrono::milliseconds(5));
+            }
+        });
+    }
+    if (options.on_progress)
+        internal.on_progress = [&](const whitted::RenderProgress& p) {
+            if (!options.on_progress({p.tiles_done, p.tiles_total, p.rays, p.seconds})) stop.store(true);
+        };
+    whitted::RenderResult result;
+    try {
+        result = whitted::render(scene.impl().scene, accelerator, internal);
+    } catch (...) {
+        watching.store(false);
+        if (watcher.joinable()) watcher.join();
+        throw;
+    }
+    watching.store(false);
+    if (watcher.joinable()) watcher.join();
+    return result;
+}
+
+RenderStats stats_of(const whitted::RenderResult& result) {
+    return {result.rays.camera, result.rays.shadow, result.rays.reflected, result.seconds};
+}
+
+SourceLocation builder_where(int call) {
+    return {FileName("<SceneBuilder>"), call, 1};
+}
+
+template <class T>
+Located<T> given(T value, const SourceLocation& where) {
+    Located<T> located(std::move(value));
+    located.where = where;
+    located.given = true;
+    return located;
+}
+
+whitted::Vec3 vec(const Vec3& v) {
+    return {v.x, v.y, v.z};
+}
+
+}  // namespace
+
+const char* version() {
+    return WHITTED_VERSION_STRING;
+}
+
+const Accelerator& Scene::Impl::accelerator(int threads) const {
+    std::lock_guard lock(m_mutex);
+    if (!m_accelerator) m_accelerator = std::make_unique<Accelerator>(scene, threads);
+    return *m_accelerator;
+}
+
+const SceneDescription& Scene::Impl::converter_description() const {
+    if (objects_kept) return description;
+    std::lock_guard lock(m_mutex);
+    if (!m_reread) m_reread = std::make_unique<SceneDescription>(parse_scene_file(description.path));
+    return *m_reread;
+}
+
+Scene::Scene(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
+Scene::Scene(Scene&&) noexcept = default;
+Scene& Scene::operator=(Scene&&) noexcept = default;
+Scene::~Scene() = default;
+
+int Scene::width() const {
+    return m_impl->scene.width;
+}
+int Scene::height() const {
+    return m_impl->scene.height;
+}
+int Scene::samples() const {
+    return m_impl->scene.samples;
+}
+int Scene::max_depth() const {
+    return m_impl->scene.max_depth;
+}
+const std::string& Scene::path() const {
+    return m_impl->description.path;
+}
+std::vector<std::string> Scene::layers() const {
+    std::vector<std::string> names;
+    for (const auto& layer : m_impl->description.layers) names.push_back(layer.value);
+    return names;
+}
+
+Expected<Scene> load_scene_file(const std::string& path) {
+    // In one pass (scene.h): the objects are validated as they are read and their descriptions
+    // not kept, so a million spheres cost bytes each, not kilobytes; the converters read the
+    // file again (Scene::Impl::converter_description).
+    return load(path, [&](Scene::Impl& impl) {
+        impl.scene = whitted::load_scene_file(path, &impl.description);
+        impl.objects_kept = false;
+    });
+}
+
+Expected<Scene> load_scene_string(const std::string& text, const std::string& name) {
+    return load(name, [&](Scene::Impl& impl) {
+        impl.description = parse_scene_text(text, name);
+        impl.scene = validate_scene(impl.description);
+    });
+}
+
+struct SceneBuilder::Impl {
+    SceneDescription description;
+    int calls = 0;
+    int image_call = 0, camera_call = 0;
+
+    SourceLocation next() { return builder_where(++calls); }
+
+    ObjectDescription& add_object(ObjectType type, const SourceLocation& where, const api::Material& m) {
+        ObjectDescription& object = description.objects.emplace_back();
+        object.where = where;
+        object.type = type;
+        MaterialDescription material;
+        material.where = where;
+        material.ka = given(vec(m.ka), where);
+        material.kd = given(vec(m.kd), where);
+        material.ks = given(vec(m.ks), where);
+        material.p = given(m.p, where);
+        material.km = given(vec(m.km), where);
+        MaterialReference reference;
+        reference.where = where;
+        reference.inline_ = std::move(material);
+        object.material = std::move(reference);
+        return object;
+    }
+};
+
+SceneBuilder::SceneBuilder() : m_impl(std::make_unique<Impl>()) {
+    m_impl->description.path = "<SceneBuilder>";
+}
+SceneBuilder::SceneBuilder(SceneBuilder&&) noexcept = default;
+SceneBuilder& SceneBuilder::operator=(SceneBuilder&&) noexcept = default;
+SceneBuilder::~SceneBuilder() = default;
+
+SceneBuilder& SceneBuilder::image(int width, int height, int samples) {
+    const SourceLocation where = m_impl->next();
+    ImageDescription& image = m_impl->description.image;
+    image.where = where;
+    image.width = given<int64_t>(width, where);
+    image.height = given<int64_t>(height, where);
+    image.samples = given<int64_t>(samples, where);
+    m_impl->image_call = m_impl->calls;
+    return *this;
+}
+
+SceneBuilder& SceneBuilder::background(Vec3 color) {
+    m_impl->description.image.background = given(vec(color), m_impl->next());
+    return *this;
+}
+
+SceneBuilder& SceneBuilder::camera(Vec3 eye, Vec3 look_at, Vec3 up, double fov_degrees) {
+    const SourceLocation where = m_impl->next();
+    CameraDescription& camera = m_impl->description.camera;
+    camera.where = where;
+    camera.eye = given(vec(eye), where);
+    camera.look_at = given(vec(look_at), where);
+    camera.up = given(vec(up), where);
+    camera.fov = given(fov_degrees, where);
+    m_impl->camera_call = m_impl->calls;
+    return *this;
+}
+
+SceneBuilder& SceneBuilder::ambient(Vec3 intensity) {
+    m_impl->description.ambient = given(vec(intensity), m_impl->next());
+    return *this;
+}
+
+SceneBuilder& SceneBuilder::max_depth(int depth) {
+    m_impl->description.max_depth = given<int64_t>(depth, m_impl->next());
+    return *this;
+}
+
+SceneBuilder& SceneBuilder::point_light(Vec3 position, Vec3 intensity) {
+    const SourceLocation where = m_impl->next();
+    LightDescription& light = m_impl->description.lights.emplace_back();
+    light.where = where;
+    light.type = LightType::point;
+    light.position = given(vec(position), where);
+    light.intensity = given(vec(intensity), where);
+    return *this;
+}
+
+SceneBuilder& SceneBuilder::directional_light(Vec3 direction, Vec3 intensity) {
+    const SourceLocation where = m_impl->next();
+    LightDescription& light = m_impl->description.lights.emplace_back();
+    light.where = where;
+    light.type = LightType::directional;
+    light.direction = given(vec(direction), where);
+    light.intensity = given(vec(intensity), where);
+    return *this;
+}
+
+SceneBuilder& SceneBuilder::sphere(Vec3 center, double radius, const Material& material) {
+    const SourceLocation where = m_impl->next();
+    ObjectDescription& object = m_impl->add_object(ObjectType::sphere, where, material);
+    object.center = given(vec(center), where);
+    object.radius = given(radius, where);
+    return *this;
+}
+
+SceneBuilder& SceneBuilder::plane(Vec3 point, Vec3 normal, const Material& material) {
+    const SourceLocation where = m_impl->next();
+    ObjectDescription& object = m_impl->add_object(ObjectType::plane, where, material);
+    object.point = given(vec(point), where);
+    object.normal = given(vec(normal), where);
+    return *this;
+}
+
+SceneBuilder& SceneBuilder::box(Vec3 min, Vec3 max, const Material& material) {
+    const SourceLocation where = m_impl->next();
+    ObjectDescription& object = m_impl->add_object(ObjectType::box, where, material);
+    object.min = given(vec(min), where);
+    object.max = given(vec(max), where);
+    return *this;
+}
+
+SceneBuilder& SceneBuilder::triangle(Vec3 a, Vec3 b, Vec3 c, const Material& material) {
+    const SourceLocation where = m_impl->next();
+    ObjectDescription& object = m_impl->add_object(ObjectType::triangle, where, material);
+    object.vertices_where = where;
+    object.vertices = {vec(a), vec(b), vec(c)};
+    return *this;
+}
+
+Expected<Scene> SceneBuilder::build() const {
+    const Impl& impl = *m_impl;
+    const FileName file("<SceneBuilder>");
+    if (!impl.image_call)
+        return input_error(InputError({file, 0, 0}, "no image(width, height) given: the scene needs its size"));
+    if (!impl.camera_call)
+        return input_error(InputError({file, 0, 0}, "no camera(eye, look_at) given: the scene needs a camera"));
+    return load("<SceneBuilder>", [&](Scene::Impl& built) {
+        built.description = impl.description;
+        built.scene = validate_scene(built.description);
+    });
+}
+
+Expected<RenderResult> render(const Scene& scene, const RenderOptions& options) {
+    return guarded<RenderResult>("rendering " + scene.path(), [&]() -> Expected<RenderResult> {
+        whitted::RenderResult internal = render_internal(scene, options, layers_for(scene, options));
+        RenderResult result;
+        result.image = std::move(internal.image);
+        result.stats = stats_of(internal);
+        result.cancelled = internal.cancelled;
+        return result;
+    });
+}
+
+Expected<RenderStats> render_into(const Scene& scene, float* rgb, size_t floats, const RenderOptions& options) {
+    const size_t needed = size_t(scene.width()) * size_t(scene.height()) * 3;
+    if (!rgb || floats != needed)
+        return plain_error("render_into: the buffer holds " + std::to_string(floats) + " floats; the " +
+                               std::to_string(scene.width()) + "x" + std::to_string(scene.height()) + " image needs " +
+                               std::to_string(needed) + " (width*height*3)",
+                           Error::Kind::bad_input);
+    return guarded<RenderStats>("rendering " + scene.path(), [&]() -> Expected<RenderStats> {
+        RenderOptions beauty = options;
+        beauty.layers = {"none"};
+        whitted::RenderResult internal = render_internal(scene, beauty, LayerSet());
+        std::memcpy(rgb, internal.image.rgb.data(), needed * sizeof(float));
+        if (internal.cancelled) return plain_error("the render was cancelled", Error::Kind::cancelled);
+        return stats_of(internal);
+    });
+}
+
+Expected<void> write_image(const Image& image, const std::string& path, const WriteOptions& options) {
+    return guarded<void>("writing " + path, [&]() -> Expected<void> {
+        OutputOptions output;
+        output.half = options.half;
+        output.exr_compression = options.exr_compression;
+        output.bit_depth = options.bit_depth;
+        output.ocio_config = options.ocio_config;
+        output.display = options.display;
+        output.view = options.view;
+        output.metadata = options.metadata;
+        if (!image.layers.empty()) output.layers_from = "the image's layers";
+        check_output_path(path);
+        check_output_options(path, output);
+        whitted::write_image(image, path, output);
+        return {};
+    });
+}
+
+Expected<std::string> to_povray(const Scene& scene) {
+    return guarded<std::string>("converting " + scene.path(),
+                                [&]() -> Expected<std::string> { return pov::scene_to_sdl(scene.impl().converter_description()); });
+}
+
+Expected<std::string> write_povray(const Scene& scene, const std::string& pov_path) {
+    return guarded<std::string>("converting " + scene.path(), [&]() -> Expected<std::string> {
+        return pov::write_pov_files(scene.impl().converter_description(), pov_path);
+    });
+}
+
+Expected<CheckResult> check(const std::string& scene_path, const CheckOptions& options) {
+    return guarded<CheckResult>("checking " + scene_path, [&]() -> Expected<CheckResult> {
+        reference::CheckOptions internal;
+        internal.threads = options.threads;
+        internal.rule.tolerance = options.tolerance_codes / 65535.0;
+        internal.rule.required_fraction = options.min_fraction;
+        internal.rule.max_error = options.max_error_codes / 65535.0;
+        internal.report_dir = options.report_dir;
+        internal.quiet = options.quiet;
+        // `check` lives in the OpenImageIO plug-in (whitted/output/plugin.h), like the program's.
+        // Its errors come back as values: exceptions do not cross into the plug-in's own copy
+        // of the libraries. 0: done, 2: bad input, 1: failure.
+        using RunCheck =
+            int (*)(const std::string&, const reference::CheckOptions&, reference::CheckResult&, std::string&, Error&);
+        const auto run_check = reinterpret_cast<RunCheck>(image_io_plugin_symbol("whitted_api_check"));
+        reference::CheckResult result;
+        std::string verdict;
+        Error error;
+        if (const int status = run_check(scene_path, internal, result, verdict, error); status != 0) {
+            error.kind = status == 2 ? Error::Kind::bad_input : Error::Kind::failure;
+            return error;
+        }
+        CheckResult out;
+        out.passed = result.passed;
+        out.fraction_within = result.comparison.fraction_within();
+        out.max_error_codes = result.comparison.max_error * 65535.0;
+        out.psnr = result.comparison.psnr;
+        out.failures = result.failures;
+        out.verdict = verdict;
+        return out;
+    });
+}
+
+}  // namespace whitted::api

@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// The library's private side of whitted::api::Scene: the parsed description (the converters read
+// it) and the validated render Scene, with the BVH built once on demand. Only the library and the
+// `whitted` program (for --stats) include this; the public headers never do.
+
+#include "whitted/render/accelerator.h"
+#include "whitted/scene/description.h"
+#include "whitted/scene/scene.h"
+#include "whitted/whitted.h"
+
+#include <memory>
+#include <mutex>
+
+namespace whitted::api {
+
+struct Scene::Impl {
+    /// What the file says; without its objects when `objects_kept` is false (load_scene_file
+    /// reads in one pass and lets each object's description go once validated).
+    SceneDescription description;
+    bool objects_kept = true;
+    whitted::Scene scene;
+    double read_seconds = 0;  ///< load_scene_*: reading, validating and loading meshes, wall time
+
+    /// The whole description, for the converters: `description`, or the file read again.
+    const SceneDescription& converter_description() const;
+
+    /// The BVH, built by the first caller with `threads` build threads (0 = all cores) and kept.
+    /// Embree's instruction set comes from $WHITTED_EMBREE_ISA, as for `whitted render`.
+    const Accelerator& accelerator(int threads) const;
+
+private:
+    mutable std::mutex m_mutex;
+    mutable std::unique_ptr<SceneDescription> m_reread;
+    mutable std::unique_ptr<Accelerator> m_accelerator;
+};
+
+}  // namespace whitted::api

@@ -1,0 +1,268 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// Whitted's public C++ API (docs/library.md): load or build a scene, render it, write the image
+// through the colour pipeline, convert it to POV-Ray SDL, check it against POV-Ray.
+//
+// This header and the ones it includes (whitted/image.h, whitted/version.h) are all a caller
+// needs: standard C++20 only, no Embree, TBB, YAML or OpenColorIO types. Every function that can
+// fail on the caller's input returns an Expected: the value, or an Error saying what is wrong and
+// where (FILE:LINE:COL). Nothing here throws for bad input; only misuse (value() of an error)
+// throws.
+
+#include "whitted/image.h"
+#include "whitted/version.h"
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#if defined(_WIN32)
+#define WHITTED_API
+#else
+#define WHITTED_API __attribute__((visibility("default")))
+#endif
+
+namespace whitted::api {
+
+/// The library's version, "MAJOR.MINOR.PATCH" (the same as WHITTED_VERSION_STRING of the
+/// headers it was built with, and as `whitted --version`).
+WHITTED_API const char* version();
+
+/// What went wrong, and where: the scene file (or "<string>", or "<SceneBuilder>" with the
+/// number of the builder call as the line) and its 1-based line and column, 0 when unknown.
+struct Error {
+    std::string message;  ///< without the location
+    std::string file;
+    int line = 0, column = 0;
+    /// bad_input: the caller's scene or options are wrong (`whitted` exits 2); failure: it went
+    /// wrong while working, e.g. writing or out of memory (exit 1); cancelled: a render stopped by
+    /// RenderOptions::cancel or the progress callback.
+    enum class Kind { bad_input, failure, cancelled };
+    Kind kind = Kind::bad_input;
+
+    /// "FILE:LINE:COL: message" (or "FILE: message", or the message alone), as `whitted` prints it.
+    std::string what() const {
+        if (file.empty()) return message;
+        if (line <= 0) return file + ": " + message;
+        return file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + message;
+    }
+};
+
+/// Thrown only by Expected::value() on an error (a programming mistake: test first).
+class BadExpectedAccess : public std::runtime_error {
+public:
+    explicit BadExpectedAccess(Error error) : std::runtime_error(error.what()), m_error(std::move(error)) {}
+    const Error& error() const { return m_error; }
+
+private:
+    Error m_error;
+};
+
+/// A value or an Error (C++20 has no std::expected yet; this is the small part of it we need).
+template <class T>
+class Expected {
+public:
+    Expected(T value) : m_value(std::move(value)) {}      // NOLINT: implicit, like std::expected
+    Expected(Error error) : m_error(std::move(error)) {}  // NOLINT
+
+    bool has_value() const { return m_value.has_value(); }
+    explicit operator bool() const { return has_value(); }
+    T& value() & { return check(), *m_value; }
+    const T& value() const& { return check(), *m_value; }
+    T&& value() && { return check(), std::move(*m_value); }
+    T& operator*() & { return value(); }
+    const T& operator*() const& { return value(); }
+    T* operator->() { return &value(); }
+    const T* operator->() const { return &value(); }
+    /// The error; an empty one when there is a value.
+    const Error& error() const { return m_error; }
+
+private:
+    void check() const {
+        if (!m_value) throw BadExpectedAccess(m_error);
+    }
+    std::optional<T> m_value;
+    Error m_error;
+};
+
+template <>
+class Expected<void> {
+public:
+    Expected() = default;
+    Expected(Error error) : m_ok(false), m_error(std::move(error)) {}  // NOLINT
+    bool has_value() const { return m_ok; }
+    explicit operator bool() const { return m_ok; }
+    void value() const {
+        if (!m_ok) throw BadExpectedAccess(m_error);
+    }
+    const Error& error() const { return m_error; }
+
+private:
+    bool m_ok = true;
+    Error m_error;
+};
+
+/// A loaded, validated scene, ready to render (many times, from several threads at once). The
+/// acceleration structure (BVH) is built on the first render and kept. Move-only.
+class WHITTED_API Scene {
+public:
+    struct Impl;  ///< private (renderer/api/api_internal.h)
+    explicit Scene(std::unique_ptr<Impl> impl);
+    Scene(Scene&&) noexcept;
+    Scene& operator=(Scene&&) noexcept;
+    ~Scene();
+
+    int width() const;    ///< image.width, pixels
+    int height() const;   ///< image.height
+    int samples() const;  ///< image.samples: n×n rays per pixel
+    int max_depth() const;
+    /// The file it was read from, "<string>" or "<SceneBuilder>".
+    const std::string& path() const;
+    /// render.layers as written in the scene (empty: none asked for).
+    std::vector<std::string> layers() const;
+
+    Impl& impl() const { return *m_impl; }
+
+private:
+    std::unique_ptr<Impl> m_impl;
+};
+
+/// Reads and validates a scene file: YAML or JSON scene format v1 (docs/scene-format.md), or a
+/// Cornell CS4620 course .xml scene (docs/course-format.md). Mesh files are read too.
+WHITTED_API Expected<Scene> load_scene_file(const std::string& path);
+/// The same from text in memory; `name` stands for the file in messages, and relative mesh
+/// paths are resolved against its directory.
+WHITTED_API Expected<Scene> load_scene_string(const std::string& text, const std::string& name = "<string>");
+
+/// A point, direction or RGB colour.
+struct Vec3 {
+    double x = 0, y = 0, z = 0;
+};
+
+/// The lecture's material: L = ka·Ia + Σ[kd·I·max(0,n·l) + ks·I·max(0,n·h)^p] + km·L(r).
+struct Material {
+    Vec3 ka, kd, ks;
+    double p = 1;  ///< Phong exponent (Blinn-Phong half vector h)
+    Vec3 km;       ///< mirror weight
+};
+
+/// A scene built in code: each call adds what the scene file's key of the same name would say
+/// (docs/scene-format.md); build() validates it exactly like a file. An Error from build()
+/// names "<SceneBuilder>" and the number of the call (1 = the first call) as its line.
+class WHITTED_API SceneBuilder {
+public:
+    SceneBuilder();
+    SceneBuilder(SceneBuilder&&) noexcept;
+    SceneBuilder& operator=(SceneBuilder&&) noexcept;
+    ~SceneBuilder();
+
+    SceneBuilder& image(int width, int height, int samples = 1);
+    SceneBuilder& background(Vec3 color);
+    /// A perspective camera; fov is the horizontal field of view in degrees.
+    SceneBuilder& camera(Vec3 eye, Vec3 look_at, Vec3 up = {0, 1, 0}, double fov_degrees = 45);
+    SceneBuilder& ambient(Vec3 intensity);  ///< Ia (default 1, 1, 1)
+    SceneBuilder& max_depth(int depth);     ///< mirror bounces (default 5)
+    SceneBuilder& point_light(Vec3 position, Vec3 intensity);
+    SceneBuilder& directional_light(Vec3 direction, Vec3 intensity);
+    SceneBuilder& sphere(Vec3 center, double radius, const Material& material);
+    SceneBuilder& plane(Vec3 point, Vec3 normal, const Material& material);
+    SceneBuilder& box(Vec3 min, Vec3 max, const Material& material);
+    SceneBuilder& triangle(Vec3 a, Vec3 b, Vec3 c, const Material& material);
+
+    Expected<Scene> build() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> m_impl;
+};
+
+/// How far a render is.
+struct Progress {
+    size_t tiles_done = 0, tiles_total = 0;
+    uint64_t rays = 0;
+    double seconds = 0;
+};
+
+struct RenderOptions {
+    int threads = 0;  ///< 0 = all cores; the image is bit-identical for any number
+    /// Render layers (docs/layers.md), as `whitted render --layers`: "all", or names such as
+    /// "diffuse", "N". Empty: the scene's render.layers; {"none"}: none.
+    std::vector<std::string> layers;
+    /// Called a few times a second from a thread of the render's own, and once at the end.
+    /// Returning false cancels the render (like `cancel`).
+    std::function<bool(const Progress&)> on_progress;
+    /// Set to true (from any thread, or a signal handler) to stop: checked before every tile.
+    const std::atomic<bool>* cancel = nullptr;
+};
+
+struct RenderStats {
+    uint64_t camera_rays = 0, shadow_rays = 0, reflected_rays = 0;
+    double seconds = 0;  ///< the render alone, without building the BVH
+};
+
+struct RenderResult {
+    Image image;  ///< with cancelled, the finished tiles only (the others black)
+    RenderStats stats;
+    bool cancelled = false;
+};
+
+/// Renders the scene. Cancelling is not an error: the result says cancelled.
+WHITTED_API Expected<RenderResult> render(const Scene& scene, const RenderOptions& options = {});
+/// Renders the beauty into the caller's buffer: `floats` must be width·height·3 (R G B per
+/// pixel, rows from the top). A cancelled render returns an Error of kind cancelled (the
+/// buffer then holds the finished tiles). Layers are not available this way.
+WHITTED_API Expected<RenderStats> render_into(const Scene& scene, float* rgb, size_t floats,
+                                              const RenderOptions& options = {});
+
+/// How write_image writes: the options of `whitted render` of the same names.
+struct WriteOptions {
+    bool half = false;            ///< EXR: half floats instead of 32-bit floats
+    std::string exr_compression;  ///< EXR: none (default), zip, zips, piz, rle
+    int bit_depth = 0;            ///< PNG/TIFF: 8 or 16; 0 = the format's default
+    std::string ocio_config;      ///< PNG/JPEG/TIFF: empty = $OCIO, else the built-in config
+    std::string display, view;    ///< PNG/JPEG/TIFF: empty = the config's defaults
+    std::vector<std::pair<std::string, std::string>> metadata;  ///< extra string attributes
+};
+
+/// Writes the image as `whitted render` does: .exr linear (with its layers); .png/.jpg/.tif
+/// through the OpenColorIO display transform (these three load the OpenImageIO plug-in). The
+/// file appears complete or not at all.
+WHITTED_API Expected<void> write_image(const Image& image, const std::string& path, const WriteOptions& options = {});
+
+/// The scene as POV-Ray 3.7 SDL (docs/pov-model.md), as `whitted convert s.yaml s.pov` writes it.
+WHITTED_API Expected<std::string> to_povray(const Scene& scene);
+/// Writes `pov_path` and the .ini beside it that renders it like Whitted; returns the .ini path.
+WHITTED_API Expected<std::string> write_povray(const Scene& scene, const std::string& pov_path);
+
+struct CheckOptions {
+    int threads = 0;
+    double tolerance_codes = 2;   ///< per channel, in 16-bit codes (1/65535)
+    double min_fraction = 0.999;  ///< share of pixels within tolerance
+    double max_error_codes = 64;  ///< hard cap, 16-bit codes
+    std::string report_dir;       ///< empty: no report
+    bool quiet = true;            ///< false: print the figures as `whitted check` does
+};
+
+struct CheckResult {
+    bool passed = false;
+    double fraction_within = 0;  ///< share of pixels within tolerance
+    double max_error_codes = 0;  ///< largest error of any channel, 16-bit codes
+    double psnr = 0;             ///< dB
+    std::vector<std::string> failures;
+    std::string verdict;  ///< the verdict line `whitted check` prints last
+};
+
+/// `whitted check`: renders the scene file with Whitted and, converted, with POV-Ray 3.7 (found
+/// as $WHITTED_POVRAY or `povray`) and compares them pixel by pixel (docs/validation.md). Loads
+/// the OpenImageIO plug-in. A failed comparison is a result, not an Error.
+WHITTED_API Expected<CheckResult> check(const std::string& scene_path, const CheckOptions& options = {});
+
+}  // namespace whitted::api

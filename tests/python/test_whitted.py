@@ -1,0 +1,194 @@
+# SPDX-License-Identifier: MIT
+"""The Python module `whitted` (docs/library.md), from the build tree (PYTHONPATH=build/python).
+
+Run by ctest as python.module (label python); $WHITTED is the `whitted` program of the same build,
+$WHITTED_EXAMPLES the examples directory. EXR files are read back with Debian's
+python3-openimageio, which knows nothing of Whitted.
+"""
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import whitted
+
+WHITTED = os.environ["WHITTED"]
+EXAMPLES = os.environ["WHITTED_EXAMPLES"]
+SHADOWS = os.path.join(EXAMPLES, "lecture", "02-shadows.yaml")
+
+
+def read_exr(path):
+    import OpenImageIO as oiio
+    inp = oiio.ImageInput.open(path)
+    assert inp, oiio.geterror()
+    spec = inp.spec()
+    pixels = inp.read_image(0, 0, 0, spec.nchannels, oiio.FLOAT)
+    inp.close()
+    return spec, pixels
+
+
+def big_scene(samples=8, size=2000):
+    """Several hundred million camera rays: a minute or more, far longer than any test waits."""
+    return (whitted.SceneBuilder().image(size, size, samples).camera([0, 0, 5], [0, 0, 0])
+            .point_light([0, 0, 5], [1, 1, 1])
+            .sphere([0, 0, 0], 1.5, {"kd": [0.5, 0.5, 0.5], "ks": [0.3, 0.3, 0.3], "p": 20})
+            .build())
+
+
+def test_version_is_the_programs():
+    out = subprocess.run([WHITTED, "--version"], capture_output=True, text=True, check=True).stdout
+    assert out.split()[:2] == ["whitted", whitted.__version__]
+    assert whitted.version() == whitted.__version__
+
+
+def test_render_equals_the_exr_whitted_render_writes_bit_for_bit(tmp_path):
+    exr = tmp_path / "shadows.exr"
+    subprocess.run([WHITTED, "render", SHADOWS, "-o", str(exr), "-q", "-t", "2"], check=True)
+    spec, pixels = read_exr(str(exr))
+    scene = whitted.load(SHADOWS)
+    image = whitted.render(scene, threads=1)
+    assert image.dtype == np.float32
+    assert image.shape == (scene.height, scene.width, 3) == (spec.height, spec.width, 3)
+    assert pixels.dtype == np.float32
+    assert np.array_equal(image, pixels), f"{np.count_nonzero(image != pixels)} values differ"
+    assert image.any(), "an all-black image would match trivially"
+    # No copy: the array's memory is the rendered Image's, owned through its base object.
+    assert not image.flags.owndata and image.base is not None
+
+
+def test_write_image_round_trip(tmp_path):
+    image = whitted.render(whitted.load(SHADOWS), threads=2)
+    path = tmp_path / "again.exr"
+    whitted.write_image(image, str(path))
+    _, pixels = read_exr(str(path))
+    assert np.array_equal(image, pixels)
+
+
+def test_scene_built_in_code_closed_form():
+    ka, kd, ia, light = np.array([0.2, 0.1, 0.05]), np.array([0.5, 0.25, 0.125]), 0.5, 0.8
+    scene = (whitted.SceneBuilder().image(65, 65).background([0.25, 0.5, 0.75])
+             .camera([0, 0, 5], [0, 0, 0], fov=30).ambient([ia] * 3).point_light([0, 0, 5], [light] * 3)
+             .sphere([0, 0, 0], 1, {"ka": list(ka), "kd": list(kd)}).build())
+    image = whitted.render(scene)
+    # Lecture formula at the centre pixel, n = l = (0, 0, 1): L = ka*Ia + kd*I*max(0, n.l).
+    np.testing.assert_allclose(image[32, 32], ka * ia + kd * light, atol=1e-6)
+    assert list(image[0, 0]) == [np.float32(0.25), np.float32(0.5), np.float32(0.75)]
+
+
+def test_errors_carry_file_line_column(tmp_path):
+    text = "version: 1\ncamera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\nimage: {width: 8, height: -4}\n"
+    with pytest.raises(whitted.Error) as caught:
+        whitted.loads(text, "bad.yaml")
+    error = caught.value
+    assert (error.file, error.line) == ("bad.yaml", 3)
+    assert error.column > 0
+    assert str(error).startswith(f"bad.yaml:3:{error.column}: ")
+    assert error.kind == "bad_input"
+    # A file: the same, with the path as given.
+    path = tmp_path / "bad_file.yaml"
+    path.write_text(text)
+    with pytest.raises(whitted.Error, match=rf"^{path}:3:\d+: "):
+        whitted.load(str(path))
+    with pytest.raises(whitted.Error, match=r"^<SceneBuilder>:2:1: "):
+        whitted.SceneBuilder().image(8, 8).camera([0, 0, 5], [0, 0, 5]).build()
+
+
+def test_progress_callback_raising_cancels_the_render():
+    scene = big_scene()
+    calls = []
+
+    def progress(done, total):
+        calls.append((done, total))
+        raise KeyboardInterrupt
+
+    start = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        whitted.render(scene, threads=2, progress=progress)
+    elapsed = time.monotonic() - start
+    assert calls and calls[0][0] < calls[0][1], calls
+    assert elapsed < 5, f"cancelling took {elapsed:.1f} s"
+
+
+def test_progress_reports_completion():
+    scene = whitted.load(SHADOWS)
+    calls = []
+    whitted.render(scene, threads=2, progress=lambda done, total: calls.append((done, total)))
+    assert calls and calls[-1][0] == calls[-1][1] > 0
+
+
+def test_sigint_stops_a_render_within_a_second(tmp_path):
+    script = textwrap.dedent(f"""
+        import sys, time
+        sys.path.insert(0, {os.path.dirname(whitted.__file__)!r})
+        import whitted
+        scene = (whitted.SceneBuilder().image(2000, 2000, 8).camera([0, 0, 5], [0, 0, 0])
+                 .point_light([0, 0, 5], [1, 1, 1]).sphere([0, 0, 0], 1.5, {{"kd": [0.5, 0.5, 0.5]}}).build())
+        print("rendering", flush=True)
+        try:
+            whitted.render(scene, threads=2)
+        except KeyboardInterrupt:
+            print("interrupted", flush=True)
+            sys.exit(42)
+        print("finished", flush=True)
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    assert proc.stdout.readline().strip() == "rendering"
+    time.sleep(0.5)  # well inside the render
+    sent = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    try:
+        out, _ = proc.communicate(timeout=10)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        raise
+    took = time.monotonic() - sent
+    assert out.strip() == "interrupted" and proc.returncode == 42, (out, proc.returncode)
+    assert took < 1.0, f"the render stopped {took:.2f} s after SIGINT"
+
+
+def test_gil_is_released_while_rendering():
+    scene = big_scene(samples=2, size=1000)
+    done = threading.Event()
+    counted = [0]
+
+    def count():
+        while not done.is_set():
+            counted[0] += 1
+
+    counter = threading.Thread(target=count)
+    counter.start()
+    start = time.monotonic()
+    whitted.render(scene, threads=1)
+    elapsed = time.monotonic() - start
+    done.set()
+    counter.join()
+    # Had the render held the GIL, the counter would not have run at all meanwhile.
+    assert elapsed > 0.2, f"render too quick ({elapsed:.2f} s) to tell"
+    assert counted[0] > 10000, f"the other thread ran {counted[0]} times in {elapsed:.2f} s"
+
+
+def test_to_povray_and_write_povray(tmp_path):
+    scene = whitted.load(SHADOWS)
+    sdl = whitted.to_povray(scene)
+    assert "camera" in sdl and "light_source" in sdl
+    ini = whitted.write_povray(scene, str(tmp_path / "s.pov"))
+    assert ini.endswith("s.ini") and os.path.exists(ini)
+    assert (tmp_path / "s.pov").read_text() == sdl
+
+
+def test_check_against_povray():
+    povray = os.environ.get("WHITTED_POVRAY") or "povray"
+    if subprocess.run(["sh", "-c", f"command -v {povray}"], capture_output=True).returncode != 0:
+        pytest.skip("POV-Ray is not installed (scripts/setup --with-test-tools installs it)")
+    result = whitted.check(os.path.join(EXAMPLES, "lecture", "01-lambertian-sphere.yaml"), threads=2)
+    assert result.passed and result, result.verdict
+    assert result.verdict.startswith("PASS")
+    assert 0.999 <= result.fraction_within <= 1
+    with pytest.raises(whitted.Error):
+        whitted.check("/nonexistent/scene.yaml")
