@@ -12,6 +12,7 @@
 #include "whitted/output/image_output.h"
 #include "whitted/output/plugin.h"
 #include "whitted/render/accelerator.h"
+#include "whitted/render/distributed.h"
 #include "whitted/render/renderer.h"
 #include "whitted/scene/description.h"
 #include "whitted/scene/scene.h"
@@ -44,6 +45,8 @@ std::atomic<int> g_signal{0};
 /// Until the render starts nothing is written and nothing checks g_cancel (parsing, loading
 /// meshes, building the BVH can take seconds), so a signal then ends the program at once.
 std::atomic<bool> g_exit_on_signal{true};
+/// Under mpirun or srun: this process is one rank of a distributed render (docs/distributed.md).
+std::unique_ptr<WorkExchange> g_exchange;
 
 extern "C" void on_signal(int signal) {
     if (g_exit_on_signal.load()) {
@@ -185,6 +188,14 @@ int run_render(const RenderArguments& args) {
     StageTimer timer;
     Scene scene;
     double parse_seconds = 0, validate_seconds = 0;
+    if (const std::string evidence = mpi_launch_evidence(); !evidence.empty()) {
+        try {
+            g_exchange = open_mpi_exchange();
+        } catch (const std::exception& e) {
+            print_error(std::string(e.what()) + " (this process was started as an MPI rank: " + evidence + ")");
+            return exit_failure;
+        }
+    }
     install_signal_handlers();
     OutputOptions output = output_options(args);
     LayerSet layers;
@@ -252,8 +263,14 @@ int run_render(const RenderArguments& args) {
         RenderResult result;
         {
             const CancelWatchdog watchdog;
-            result = render(scene, accelerator, options);
+            result = g_exchange ? render_distributed(scene, accelerator, options, *g_exchange)
+                                : render(scene, accelerator, options);
         }
+        if (g_exchange && g_exchange->rank() != 0)  // its tiles are with rank 0, which writes the image
+            return result.cancelled ? 128 + (g_signal.load() ? g_signal.load() : SIGINT) : exit_ok;
+        if (g_exchange && !args.quiet)
+            std::fprintf(stderr, "whitted: the tiles were rendered by %d MPI rank(s) (%s)\n", g_exchange->size(),
+                         g_exchange->thread_support().c_str());
         if (options.on_progress) std::fputc('\n', stderr);
         timer.lap();
 
@@ -622,6 +639,9 @@ int main(int argc, char** argv) {
     if (*explain_cmd) return run_explain(explain_scene, explain_pixel_text, explain_json, explain_threads);
     if (*render_cmd) {
         const int code = run_render(render_args);
+        // Every rank finalizes only after success: a rank that failed exits without, so that
+        // mpirun ends the whole job instead of the others waiting for it (docs/distributed.md).
+        if (code == exit_ok && g_exchange) g_exchange->finalize();
         // The image is on disk and the summary printed: skip tearing down the BVH, the image
         // buffers and the thread pools, which took up to 30 ms of a 0.15 s render. Nothing is
         // left to flush but stdio.
