@@ -480,6 +480,8 @@ int main(int argc, char** argv) {
         "Environment: OCIO (colour config), WHITTED_POVRAY (POV-Ray for check),\n"
         "WHITTED_EMBREE_ISA=sse2|sse4.2|avx|avx2|avx512 (force Embree's instruction set; the\n"
         "image is the same bit for bit, only the speed differs; --version lists this CPU's).\n"
+        "Under mpirun or srun, `render` shares the tiles out among the ranks (WHITTED_MPI=0: don't;\n"
+        "docs/distributed.md).\n"
         "Scene format: docs/scene-format.md. Examples: examples/lecture/.\n"
         "Cornell CS4620 course scenes (.xml, with .msh meshes) render and convert directly, with the\n"
         "course's conventions: docs/course-format.md (its images: --display 'Gamma 2.2').");
