@@ -88,9 +88,11 @@ private:
         while (!done_within(std::chrono::milliseconds(20))) {
             if (!g_cancel.load()) continue;
             if (done_within(std::chrono::milliseconds(900))) return;
-            std::fprintf(stderr,
-                         "whitted: interrupted; a tile did not finish within a second, "
-                         "stopped without writing anything\n");
+            // Under MPI rank 0 can also be waiting on a rank that died in the middle of a message.
+            std::fprintf(stderr, g_exchange ? "whitted: interrupted; a tile or a message from another rank did not "
+                                              "arrive within a second, stopped without writing anything\n"
+                                            : "whitted: interrupted; a tile did not finish within a second, "
+                                              "stopped without writing anything\n");
             std::fflush(stderr);
             ::_exit(128 + g_signal.load());
         }
