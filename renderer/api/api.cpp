@@ -7,6 +7,7 @@
 #include "reference/check.h"
 #include "whitted/output/image_output.h"
 #include "whitted/output/plugin.h"
+#include "whitted/render/distributed.h"
 #include "whitted/render/layers.h"
 #include "whitted/render/renderer.h"
 
@@ -96,7 +97,8 @@ LayerSet layers_for(const Scene& scene, const RenderOptions& options) {
     return layers;
 }
 
-whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& options, LayerSet layers) {
+whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& options, LayerSet layers,
+                                      WorkExchange* exchange = nullptr) {
     const Accelerator& accelerator = scene.impl().accelerator(options.threads);
     // The progress callback may cancel too: then one flag of ours for both, set by either (the
     // caller's copied in by a watcher); without a callback the tiles check the caller's own.
@@ -122,7 +124,8 @@ whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& o
         };
     whitted::RenderResult result;
     try {
-        result = whitted::render(scene.impl().scene, accelerator, internal);
+        result = exchange ? whitted::render_distributed(scene.impl().scene, accelerator, internal, *exchange)
+                          : whitted::render(scene.impl().scene, accelerator, internal);
     } catch (...) {
         watching.store(false);
         if (watcher.joinable()) watcher.join();
@@ -352,8 +355,12 @@ Expected<Scene> SceneBuilder::build() const {
 }
 
 Expected<RenderResult> render(const Scene& scene, const RenderOptions& options) {
+    return render_distributed(scene, options, nullptr);
+}
+
+Expected<RenderResult> render_distributed(const Scene& scene, const RenderOptions& options, WorkExchange* exchange) {
     return guarded<RenderResult>("rendering " + scene.path(), [&]() -> Expected<RenderResult> {
-        whitted::RenderResult internal = render_internal(scene, options, layers_for(scene, options));
+        whitted::RenderResult internal = render_internal(scene, options, layers_for(scene, options), exchange);
         RenderResult result;
         result.image = std::move(internal.image);
         result.stats = stats_of(internal);

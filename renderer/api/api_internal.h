@@ -6,6 +6,7 @@
 // `whitted` program (for --stats) include this; the public headers never do.
 
 #include "whitted/render/accelerator.h"
+#include "whitted/render/work_exchange.h"
 #include "whitted/scene/description.h"
 #include "whitted/scene/scene.h"
 #include "whitted/whitted.h"
@@ -35,5 +36,10 @@ private:
     mutable std::unique_ptr<SceneDescription> m_reread;
     mutable std::unique_ptr<Accelerator> m_accelerator;
 };
+
+/// api::render with the tiles shared among MPI ranks through `exchange` (null: one process), for
+/// `whitted render` under mpirun (docs/distributed.md); not in the public API yet. On a rank other
+/// than 0 the image holds only the tiles that rank rendered.
+Expected<RenderResult> render_distributed(const Scene& scene, const RenderOptions& options, WorkExchange* exchange);
 
 }  // namespace whitted::api

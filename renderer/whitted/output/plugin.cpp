@@ -5,6 +5,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <mutex>
 #include <stdexcept>
 #include <vector>
@@ -12,9 +13,7 @@
 namespace whitted {
 namespace {
 
-constexpr const char* plugin_file = "libwhitted_oiio.so";
-
-void* load_plugin() {
+void* load_plugin(const char* plugin_file, const char* needed_for) {
     std::vector<std::filesystem::path> candidates;
     if (const char* dir = std::getenv("WHITTED_PLUGIN_DIR"); dir && *dir) candidates.emplace_back(dir);
     std::error_code error;
@@ -44,27 +43,42 @@ void* load_plugin() {
         if (void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)) return handle;
         tried += "\n  " + path.string() + " (" + dlerror() + ")";
     }
-    throw std::runtime_error(std::string("cannot load the OpenImageIO plug-in ") + plugin_file +
-                             " (needed for `whitted check` and `whitted compare`); tried:" + tried);
+    throw std::runtime_error(std::string("cannot load the plug-in ") + plugin_file + " (" + needed_for +
+                             "); tried:" + tried);
 }
 
 }  // namespace
 
-void* image_io_plugin_symbol(const char* name) {
-    static std::once_flag once;
-    static void* handle = nullptr;
-    static std::string load_error;
-    std::call_once(once, [] {
-        try {
-            handle = load_plugin();
-        } catch (const std::exception& e) {
-            load_error = e.what();
+void* plugin_symbol(const char* file, const char* name, const char* needed_for) {
+    struct Loaded {
+        void* handle = nullptr;
+        std::string error;
+    };
+    static std::mutex mutex;
+    static std::map<std::string, Loaded> loaded;
+    void* handle;
+    {
+        std::lock_guard lock(mutex);
+        auto [it, first] = loaded.try_emplace(file);
+        if (first) {
+            try {
+                it->second.handle = load_plugin(file, needed_for);
+            } catch (const std::exception& e) {
+                it->second.error = e.what();
+            }
         }
-    });
-    if (!handle) throw std::runtime_error(load_error);
+        if (!it->second.handle) throw std::runtime_error(it->second.error);
+        handle = it->second.handle;
+    }
     void* symbol = dlsym(handle, name);
-    if (!symbol) throw std::runtime_error(std::string("the OpenImageIO plug-in has no '") + name + "'");
+    if (!symbol) throw std::runtime_error(std::string("the plug-in ") + file + " has no '" + name + "'");
     return symbol;
+}
+
+void* image_io_plugin_symbol(const char* name) {
+    return plugin_symbol("libwhitted_oiio.so", name,
+                         "the OpenImageIO plug-in, needed for `whitted check` and "
+                         "`whitted compare`");
 }
 
 }  // namespace whitted

@@ -17,4 +17,8 @@ namespace whitted {
 /// saying where it looked when the plug-in cannot be loaded.
 void* image_io_plugin_symbol(const char* name);
 
+/// The same for any of our plug-ins (lib/`file`, e.g. libwhitted_mpi.so); `needed_for` ends
+/// the message when it cannot be loaded.
+void* plugin_symbol(const char* file, const char* name, const char* needed_for);
+
 }  // namespace whitted

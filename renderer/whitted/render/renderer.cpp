@@ -184,12 +184,22 @@ std::vector<CameraPacket> camera_packets(const Scene& scene, int i, int j) {
     return packets;
 }
 
+size_t render_tile_count(int width, int height) {
+    constexpr int tile = render_tile_size;
+    return size_t((width + tile - 1) / tile) * size_t((height + tile - 1) / tile);
+}
+
+TileRect render_tile_rect(int width, int height, size_t t) {
+    constexpr int tile = render_tile_size;
+    const int tiles_x = (width + tile - 1) / tile;
+    const int x_begin = int(t % tiles_x) * tile, y_begin = int(t / tiles_x) * tile;
+    return {x_begin, std::min(x_begin + tile, width), y_begin, std::min(y_begin + tile, height)};
+}
+
 RenderResult render(const Scene& scene, const Accelerator& accelerator, const RenderOptions& options) {
     using clock = std::chrono::steady_clock;
     const auto start = clock::now();
-    constexpr int tile = 32;
-    const int tiles_x = (scene.width + tile - 1) / tile, tiles_y = (scene.height + tile - 1) / tile;
-    const size_t tile_count = size_t(tiles_x) * tiles_y;
+    const size_t tile_count = render_tile_count(scene.width, scene.height);
 
     RenderResult result;
     result.image.width = scene.width;
@@ -217,33 +227,46 @@ RenderResult render(const Scene& scene, const Accelerator& accelerator, const Re
         });
     }
 
+    const auto render_tile = [&](size_t t) {
+        const TileRect rect = render_tile_rect(scene.width, scene.height, t);
+        const int x_begin = rect.x_begin, x_end = rect.x_end, y_begin = rect.y_begin, y_end = rect.y_end;
+        RayCounts counts;
+        if (!options.layers.empty()) {
+            render_tile_layers(scene, shading, options.layers, x_begin, x_end, y_begin, y_end, result.image, counts);
+        } else if (scene.samples == 1) {
+            render_block_single_sample(scene, shading, x_begin, x_end, y_begin, y_end, result.image, counts);
+        } else {
+            for (int y = y_begin; y < y_end; ++y) {
+                for (int x = x_begin; x < x_end; ++x) {
+                    const Color c = render_pixel(scene, shading, x, y, counts);
+                    float* out = &result.image.rgb[3 * (size_t(y) * scene.width + x)];
+                    out[0] = float(c.x), out[1] = float(c.y), out[2] = float(c.z);
+                }
+            }
+        }
+        camera_rays += counts.camera;
+        shadow_rays += counts.shadow;
+        reflected_rays += counts.reflected;
+        if (options.on_tile_done) options.on_tile_done(t, result.image, counts);
+        ++tiles_done;
+    };
+    const auto cancelled = [&] { return options.cancel && options.cancel->load(std::memory_order_relaxed); };
+
     const int threads = options.threads > 0 ? options.threads : tbb::this_task_arena::max_concurrency();
     tbb::task_arena arena(threads);
     arena.execute([&] {
+        if (options.next_tile) {
+            // One loop per thread, each asking the tile source until it has no more.
+            tbb::parallel_for(0, threads, [&](int) {
+                size_t t;
+                while (!cancelled() && options.next_tile(t)) render_tile(t);
+            });
+            return;
+        }
         tbb::parallel_for(tbb::blocked_range<size_t>(0, tile_count, 1), [&](const tbb::blocked_range<size_t>& range) {
             for (size_t t = range.begin(); t != range.end(); ++t) {
-                if (options.cancel && options.cancel->load(std::memory_order_relaxed)) return;
-                const int x_begin = int(t % tiles_x) * tile, y_begin = int(t / tiles_x) * tile;
-                const int x_end = std::min(x_begin + tile, scene.width), y_end = std::min(y_begin + tile, scene.height);
-                RayCounts counts;
-                if (!options.layers.empty()) {
-                    render_tile_layers(scene, shading, options.layers, x_begin, x_end, y_begin, y_end, result.image,
-                                       counts);
-                } else if (scene.samples == 1) {
-                    render_block_single_sample(scene, shading, x_begin, x_end, y_begin, y_end, result.image, counts);
-                } else {
-                    for (int y = y_begin; y < y_end; ++y) {
-                        for (int x = x_begin; x < x_end; ++x) {
-                            const Color c = render_pixel(scene, shading, x, y, counts);
-                            float* out = &result.image.rgb[3 * (size_t(y) * scene.width + x)];
-                            out[0] = float(c.x), out[1] = float(c.y), out[2] = float(c.z);
-                        }
-                    }
-                }
-                camera_rays += counts.camera;
-                shadow_rays += counts.shadow;
-                reflected_rays += counts.reflected;
-                ++tiles_done;
+                if (cancelled()) return;
+                render_tile(t);
             }
         });
     });
@@ -258,7 +281,8 @@ RenderResult render(const Scene& scene, const Accelerator& accelerator, const Re
     }
     result.rays = {camera_rays.load(), shadow_rays.load(), reflected_rays.load()};
     result.seconds = std::chrono::duration<double>(clock::now() - start).count();
-    result.cancelled = tiles_done.load() != tile_count;
+    // With a tile source this process renders only some tiles: it was cancelled if told to stop.
+    result.cancelled = options.next_tile ? cancelled() : tiles_done.load() != tile_count;
     if (options.on_progress) options.on_progress({tiles_done.load(), tile_count, result.rays.total(), result.seconds});
     return result;
 }

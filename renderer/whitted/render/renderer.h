@@ -30,7 +30,24 @@ struct RenderOptions {
     const std::atomic<bool>* cancel = nullptr;
     /// Called from one thread a few times a second while rendering (e.g. a progress bar).
     std::function<void(const RenderProgress&)> on_progress;
+    /// Where the tiles come from (a distributed render: docs/distributed.md). Unset: every tile,
+    /// spread over the threads. Set: each worker thread asks it for a tile index (row-major,
+    /// tile_rect) until it returns false, so this process renders only the tiles it is given;
+    /// it is called from several threads at once.
+    std::function<bool(size_t& tile)> next_tile;
+    /// Called from the worker thread that finished `tile`, once its pixels are in `image`
+    /// (only that tile's rectangle is final; other tiles are being written meanwhile).
+    std::function<void(size_t tile, const struct Image& image, const RayCounts& counts)> on_tile_done;
 };
+
+/// render() works in square tiles of this many pixels a side, numbered row by row.
+constexpr int render_tile_size = 32;
+struct TileRect {
+    int x_begin, x_end, y_begin, y_end;
+    size_t pixels() const { return size_t(x_end - x_begin) * size_t(y_end - y_begin); }
+};
+size_t render_tile_count(int width, int height);
+TileRect render_tile_rect(int width, int height, size_t tile);
 
 struct RenderResult {
     Image image;
