@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <numbers>
 #include <unordered_map>
 
@@ -62,6 +63,32 @@ public:
         }
     }
 
+    /// Every prototype, in file order, before any object (an instance may come before the
+    /// `prototypes` key in the file). Only meshes and triangles, in groups or not, may be in one:
+    /// instances share triangles through Embree's instancing; analytic shapes and planes are not
+    /// instanced (and instances inside prototypes are not nested).
+    void add_prototypes() {
+        for (const PrototypeDescription& d : m_description.prototypes) {
+            m_prototype_index[d.name] = static_cast<uint32_t>(m_scene.prototypes.size());
+            m_prototype_names.push_back(d.name);
+            Prototype prototype;
+            prototype.name = d.name;
+            m_prototype = &prototype;
+            add_object(d.object, Transform());
+            m_prototype = nullptr;
+            if (prototype.meshes.empty())
+                fail(d.where, "prototypes." + printable(d.name) + ": the prototype holds no triangles");
+            constexpr double inf = std::numeric_limits<double>::infinity();
+            prototype.lo = Vec3(inf), prototype.hi = Vec3(-inf);
+            for (const TriangleMesh& mesh : prototype.meshes)
+                for (size_t i = 0; i < mesh.vertex_count(); ++i) {
+                    const Vec3 p{mesh.positions[4 * i], mesh.positions[4 * i + 1], mesh.positions[4 * i + 2]};
+                    prototype.lo = min(prototype.lo, p), prototype.hi = max(prototype.hi, p);
+                }
+            m_scene.prototypes.push_back(std::move(prototype));
+        }
+    }
+
     void add_objects(const std::vector<ObjectDescription>& objects, const Transform& parent) {
         for (const auto& object : objects) add_object(object, parent);
     }
@@ -69,6 +96,8 @@ public:
 private:
     uint32_t resolve_material(const ObjectDescription& object) {
         const std::string kind = to_string(object.type);
+        // In a prototype the material may be left to each instance.
+        if (!object.material && m_prototype) return Instance::no_material;
         if (!object.material) fail(object.where, kind + ": missing required key 'material'");
         const MaterialReference& reference = *object.material;
         if (reference.inline_) {
@@ -93,7 +122,15 @@ private:
         if (!(std::fabs(to_world.determinant()) > 1e-300))
             fail(object.transform.empty() ? object.where : object.transform.front().where,
                  "the transform is singular (it flattens the object)");
+        if (m_prototype && object.type != ObjectType::mesh && object.type != ObjectType::triangle &&
+            object.type != ObjectType::group)
+            fail(object.where, std::string("prototypes.") + printable(m_prototype->name) +
+                                   (object.type == ObjectType::instance ? ": an " : ": a ") + to_string(object.type) +
+                                   " cannot be in a prototype; prototypes hold meshes and triangles (in groups or not)");
         switch (object.type) {
+            case ObjectType::instance:
+                add_instance(object, to_world);
+                break;
             case ObjectType::sphere: {
                 if (!(object.radius.value > 0)) fail(object.radius.where, "sphere.radius must be > 0");
                 m_scene.spheres.push_back(
@@ -134,6 +171,45 @@ private:
                 add_objects(object.children, to_world);
                 break;
         }
+    }
+
+    void add_instance(const ObjectDescription& object, const Transform& to_world) {
+        const auto it = m_prototype_index.find(object.prototype.value);
+        if (it == m_prototype_index.end())
+            fail(object.prototype.where,
+                 "instance: unknown prototype '" + printable(object.prototype.value) + "'" +
+                     did_you_mean(object.prototype.value, m_prototype_names) +
+                     (m_prototype_names.empty() ? "; the scene defines no prototypes"
+                                                : "; defined: " + join_names(m_prototype_names)));
+        const Prototype& prototype = m_scene.prototypes[it->second];
+        Instance instance;
+        instance.object_to_world = to_world;
+        instance.prototype = it->second;
+        if (object.material) {
+            instance.material = resolve_material(object);
+        } else {
+            for (const TriangleMesh& mesh : prototype.meshes)
+                if (mesh.triangle_materials.empty() && mesh.material == Instance::no_material)
+                    fail(object.where, "instance: prototype '" + printable(prototype.name) +
+                                           "' has triangles without a material; give the instance a 'material'");
+        }
+        // Embree holds the transform and the prototype's bounds in float.
+        for (int corner = 0; corner < 8; ++corner) {
+            const Vec3 p = to_world.apply_point({corner & 1 ? prototype.hi.x : prototype.lo.x,
+                                                 corner & 2 ? prototype.hi.y : prototype.lo.y,
+                                                 corner & 4 ? prototype.hi.z : prototype.lo.z});
+            if (!(std::isfinite(float(p.x)) && std::isfinite(float(p.y)) && std::isfinite(float(p.z))))
+                fail(object.where, "instance: prototype '" + printable(prototype.name) +
+                                       "' placed here reaches beyond float range (about 3.4e38)");
+        }
+        instance.object = add_id(object);
+        m_scene.instances.push_back(instance);
+    }
+
+    static std::string join_names(const std::vector<std::string>& names) {
+        std::string out;
+        for (const auto& name : names) out += (out.empty() ? "" : ", ") + printable(name);
+        return out;
     }
 
     void add_inline_mesh(const ObjectDescription& object, const Transform& to_world) {
@@ -225,11 +301,13 @@ private:
             if (!std::isfinite(mesh.positions[i]))
                 fail(where, "vertex " + std::to_string(i / 4) +
                                 " is beyond float range (about 3.4e38) once transformed to world space");
-        m_scene.meshes.push_back(std::move(mesh));
+        (m_prototype ? m_prototype->meshes : m_scene.meshes).push_back(std::move(mesh));
     }
 
-    /// The object's number (1-based, file order): see SceneObject.
+    /// The object's number (1-based, file order): see SceneObject. Inside a prototype none: the
+    /// instance is the object.
     uint32_t add_id(const ObjectDescription& object) {
+        if (m_prototype) return 0;
         m_scene.objects.push_back({object.type, object.where});
         return static_cast<uint32_t>(m_scene.objects.size());
     }
@@ -274,6 +352,9 @@ private:
     Scene& m_scene;
     std::unordered_map<std::string, uint32_t> m_material_index;
     std::vector<std::string> m_material_names;
+    std::unordered_map<std::string, uint32_t> m_prototype_index;
+    std::vector<std::string> m_prototype_names;
+    Prototype* m_prototype = nullptr;  ///< the prototype being built, or null: the scene's own objects
 };
 
 }  // namespace
@@ -281,6 +362,16 @@ private:
 size_t Scene::triangle_count() const {
     size_t n = 0;
     for (const auto& mesh : meshes) n += mesh.triangle_count();
+    for (const auto& prototype : prototypes)
+        for (const auto& mesh : prototype.meshes) n += mesh.triangle_count();
+    return n;
+}
+
+size_t Scene::instanced_triangle_count() const {
+    size_t n = 0;
+    for (const auto& mesh : meshes) n += mesh.triangle_count();
+    for (const auto& instance : instances)
+        for (const auto& mesh : prototypes[instance.prototype].meshes) n += mesh.triangle_count();
     return n;
 }
 
@@ -431,6 +522,7 @@ Scene validate_scene(const SceneDescription& d) {
     }
 
     SceneBuilder builder(d, scene);
+    builder.add_prototypes();
     builder.add_objects(d.objects, Transform());
     if (static_cast<int64_t>(scene.triangle_count()) > limits::max_triangles)
         throw InputError({d.path}, "the scene has " + std::to_string(scene.triangle_count()) +
