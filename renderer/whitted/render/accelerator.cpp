@@ -514,9 +514,10 @@ struct Accelerator::Impl {
             double norm = 0;
             for (int row = 0; row < 3; ++row)
                 norm = std::max(norm, std::fabs(m[4 * row]) + std::fabs(m[4 * row + 1]) + std::fabs(m[4 * row + 2]));
-            local_reach = std::max({local_reach, norm * std::max({std::fabs(prototype.lo.x), std::fabs(prototype.lo.y),
-                                                                  std::fabs(prototype.lo.z), std::fabs(prototype.hi.x),
-                                                                  std::fabs(prototype.hi.y), std::fabs(prototype.hi.z)})});
+            local_reach =
+                std::max({local_reach, norm * std::max({std::fabs(prototype.lo.x), std::fabs(prototype.lo.y),
+                                                        std::fabs(prototype.lo.z), std::fabs(prototype.hi.x),
+                                                        std::fabs(prototype.hi.y), std::fabs(prototype.hi.z)})});
         }
         EmbreeFrame chosen;
         if (!(lo.x <= hi.x)) return chosen;  // no finite shape: Embree has nothing to find
@@ -761,9 +762,10 @@ struct Accelerator::Impl {
             rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
             rtcIntersect1(rtc_scene, &context.embree, &rayhit);
             bool retry = false;
-            const bool found = finish_hit(ray, rayhit.hit.instID[0], rayhit.hit.geomID, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v,
-                                          rayhit.ray.tfar, {rayhit.hit.Ng_x, rayhit.hit.Ng_y, rayhit.hit.Ng_z},
-                                          context.best_t[0], context.best_normal[0], out, retry);
+            const bool found =
+                finish_hit(ray, rayhit.hit.instID[0], rayhit.hit.geomID, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v,
+                           rayhit.ray.tfar, {rayhit.hit.Ng_x, rayhit.hit.Ng_y, rayhit.hit.Ng_z}, context.best_t[0],
+                           context.best_normal[0], out, retry);
             // A bounded number of refusals in a row (a fan of grazing neighbours); past it the
             // planes alone answer, as if the triangles had been missed.
             if (!retry) return found;
@@ -831,8 +833,8 @@ struct Accelerator::Impl {
             const int i = first + lane;
             if (!valid[lane]) continue;
             bool retry = false;
-            found[i] = finish_hit(rays[i], packet.hit.instID[0][lane], packet.hit.geomID[lane], packet.hit.primID[lane], packet.hit.u[lane],
-                                  packet.hit.v[lane], packet.ray.tfar[lane],
+            found[i] = finish_hit(rays[i], packet.hit.instID[0][lane], packet.hit.geomID[lane], packet.hit.primID[lane],
+                                  packet.hit.u[lane], packet.hit.v[lane], packet.ray.tfar[lane],
                                   {packet.hit.Ng_x[lane], packet.hit.Ng_y[lane], packet.hit.Ng_z[lane]},
                                   context.best_t[i], context.best_normal[i], hits[i], retry);
             if (retry) found[i] = intersect_beyond(rays[i], packet.ray.tfar[lane], hits[i]);

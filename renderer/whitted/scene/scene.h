@@ -92,14 +92,14 @@ struct Prototype {
 struct Instance {
     static constexpr uint32_t no_material = 0xFFFFFFFFu;
     Transform object_to_world;
-    uint32_t prototype = 0;            ///< Scene::prototypes index
-    uint32_t material = no_material;   ///< the override, or no_material: the prototype's own
-    uint32_t object = 0;               ///< Scene::objects index + 1
+    uint32_t prototype = 0;           ///< Scene::prototypes index
+    uint32_t material = no_material;  ///< the override, or no_material: the prototype's own
+    uint32_t object = 0;              ///< Scene::objects index + 1
 };
 
 /// A shape as the scene file wrote it: sphere, plane, box, triangle or mesh (groups are not
-/// objects; their members are; an instance is one object, whatever its prototype holds). Numbered 1, 2, ... in file order, depth first through groups:
-/// the `objectId` layer and `whitted explain` use these numbers (0 = nothing hit).
+/// objects; their members are; an instance is one object, whatever its prototype holds). Numbered 1, 2, ... in file
+/// order, depth first through groups: the `objectId` layer and `whitted explain` use these numbers (0 = nothing hit).
 struct SceneObject {
     ObjectType type = ObjectType::sphere;
     SourceLocation where;

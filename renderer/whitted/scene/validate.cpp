@@ -124,9 +124,10 @@ private:
                  "the transform is singular (it flattens the object)");
         if (m_prototype && object.type != ObjectType::mesh && object.type != ObjectType::triangle &&
             object.type != ObjectType::group)
-            fail(object.where, std::string("prototypes.") + printable(m_prototype->name) +
-                                   (object.type == ObjectType::instance ? ": an " : ": a ") + to_string(object.type) +
-                                   " cannot be in a prototype; prototypes hold meshes and triangles (in groups or not)");
+            fail(object.where,
+                 std::string("prototypes.") + printable(m_prototype->name) +
+                     (object.type == ObjectType::instance ? ": an " : ": a ") + to_string(object.type) +
+                     " cannot be in a prototype; prototypes hold meshes and triangles (in groups or not)");
         switch (object.type) {
             case ObjectType::instance:
                 add_instance(object, to_world);
