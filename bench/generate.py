@@ -7,7 +7,18 @@ All 1280x960, max_depth 5, one sample per pixel, a glazed mirror floor and two p
   generate.py [OUT_DIR]                          the anchor scenes
   generate.py --many N [--json] [OUT_DIR]        many-N.yaml (or .json): N small spheres on a
                                                  mirror floor, 640x480, one point light, for
-                                                 measuring how parsing and memory scale with N"""
+                                                 measuring how parsing and memory scale with N
+  generate.py --instances N [OUT_DIR]            instances-N.yaml: N placements of the
+                                                 100k-triangle torus (one prototype, torus100k.obj)
+                                                 on a grid, 640x480, each turned and coloured its
+                                                 own way; with N = 1 also instances-1-plain.yaml,
+                                                 the same torus as a plain mesh
+  generate.py --torus TRIANGLES [OUT_DIR]        torus-T.yaml (+ .obj): one torus of about T
+                                                 triangles, 640x480
+  generate.py --lights N [OUT_DIR]               lights-N.yaml: the 100 spheres under N point
+                                                 lights of total intensity 1.4, 640x480
+  generate.py --image MEGAPIXELS [OUT_DIR]       image-M.yaml: the 100 spheres at about M
+                                                 megapixels (4:3)"""
 import math
 import random
 import sys
@@ -116,10 +127,100 @@ def many_spheres(out: Path, n: int, as_json: bool) -> Path:
     return path
 
 
+SMALL_HEADER = HEADER.replace("width: 1280, height: 960", "width: 640, height: 480")
+
+
+def instances(out: Path, n: int) -> list:
+    """N instances of the 100k torus on a square grid seen from above at an angle, each turned
+    about y by its own angle and tinted by one of five materials. The camera backs off as the
+    grid grows so that every instance is in view."""
+    if not (out / "torus100k.obj").exists():
+        torus_obj(out / "torus100k.obj", 316, 158)
+    side = math.ceil(math.sqrt(n))
+    spacing = 3.2
+    extent = spacing * side
+    eye = [0, 0.9 * extent + 2.5, 0.95 * extent + 5.5]
+    header = SMALL_HEADER.replace("eye: [0, 2.5, 6.5], look_at: [0, 1, 0]",
+                                  f"eye: [{eye[0]}, {eye[1]:.3f}, {eye[2]:.3f}], look_at: [0, 0.5, 0]")
+    text = [header.format(name=f"instances-{n}"),
+            "  m0: { kd: [0.6, 0.35, 0.2], ks: 0.5, p: 60, km: 0.1 }\n"
+            "  m1: { kd: [0.2, 0.5, 0.6], ks: 0.4, p: 30 }\n"
+            "  m2: { kd: [0.6, 0.6, 0.2], ks: 0.3, p: 80 }\n"
+            "  m3: { kd: [0.5, 0.2, 0.5], ks: 0.5, p: 20, km: 0.2 }\n"
+            "  m4: { kd: [0.3, 0.6, 0.3], ks: 0.2, p: 10 }\n",
+            "prototypes:\n  torus: { type: mesh, file: torus100k.obj }\n",
+            "objects:\n  - { type: plane, point: [0, 0, 0], normal: [0, 1, 0], material: floor }\n"]
+    for i in range(n):
+        row, col = divmod(i, side)
+        x, z = (col - (side - 1) / 2) * spacing, (row - (side - 1) / 2) * spacing
+        text.append(f"  - {{ type: instance, prototype: torus, material: m{i % 5}, transform: [ "
+                    f"{{ rotate: {{ axis: [1, 0, 0], angle: 60 }} }}, {{ rotate: {{ axis: [0, 1, 0], angle: {(37 * i) % 360} }} }}, "
+                    f"{{ translate: [{x:.3f}, 1.2, {z:.3f}] }} ] }}\n")
+    paths = [out / f"instances-{n}.yaml"]
+    paths[0].write_text("".join(text))
+    if n == 1:
+        plain = "".join(text).replace("prototypes:\n  torus: { type: mesh, file: torus100k.obj }\n", "")
+        plain = plain.replace("type: instance, prototype: torus,", "type: mesh, file: torus100k.obj,")
+        paths.append(out / "instances-1-plain.yaml")
+        paths[1].write_text(plain)
+    return paths
+
+
+def torus_scene(out: Path, triangles: int) -> Path:
+    """One torus of about `triangles` triangles (major = 2·minor segments), 640x480."""
+    minor = max(3, round(math.sqrt(triangles / 4)))
+    name = f"torus-{triangles}"
+    count = torus_obj(out / f"{name}.obj", 2 * minor, minor)
+    text = SMALL_HEADER.format(name=name) + f"""  torus: {{ kd: [0.6, 0.35, 0.2], ks: 0.5, p: 60, km: 0.1 }}
+objects:
+  - {{ type: plane, point: [0, 0, 0], normal: [0, 1, 0], material: floor }}
+  # {count} triangles
+  - type: mesh
+    file: {name}.obj
+    material: torus
+    transform: [ {{ rotate: {{ axis: [1, 0, 0], angle: 60 }} }}, {{ translate: [0, 1.6, -0.5] }} ]
+"""
+    path = out / f"{name}.yaml"
+    path.write_text(text)
+    return path
+
+
+def lights_scene(out: Path, n: int) -> Path:
+    """The 100 spheres of the anchor, 640x480, under N point lights on a ring above them whose
+    intensities add up to 1.4 (the image keeps its brightness as N grows)."""
+    spheres(out)
+    body = (out / "spheres.yaml").read_text()
+    start, end = body.index("lights:"), body.index("materials:")
+    ring = ["lights:\n"]
+    for i in range(n):
+        a = 2 * math.pi * i / n
+        ring.append(f"  - {{ type: point, position: [{6 * math.cos(a):.4f}, {6 + 2 * math.sin(3 * a):.4f}, "
+                    f"{6 * math.sin(a):.4f}], intensity: {1.4 / n:.6g} }}\n")
+    text = body[:start] + "".join(ring) + body[end:]
+    text = text.replace("width: 1280, height: 960", "width: 640, height: 480")
+    path = out / f"lights-{n}.yaml"
+    path.write_text(text)
+    return path
+
+
+def image_scene(out: Path, megapixels: float) -> Path:
+    """The 100 spheres of the anchor at about `megapixels` million pixels, 4:3."""
+    spheres(out)
+    width = int(round(math.sqrt(megapixels * 1e6 * 4 / 3) / 4)) * 4
+    height = width * 3 // 4
+    text = (out / "spheres.yaml").read_text().replace("width: 1280, height: 960", f"width: {width}, height: {height}")
+    path = out / f"image-{megapixels:g}.yaml"
+    path.write_text(text)
+    return path
+
+
 def main() -> None:
     # generate.py [OUT_DIR [NAME ...]]: all three anchors, or only those named (the POV-Ray
     # tier's pov.torus100k makes torus100k alone); generate.py --many N [--json] [OUT_DIR].
     args = sys.argv[1:]
+    if args and args[0] in ("-h", "--help"):  # not an output directory named "--help"
+        print(__doc__)
+        return
     if args and args[0] == "--many":
         n = int(args[1])
         as_json = "--json" in args[2:]
@@ -127,6 +228,15 @@ def main() -> None:
         out = Path(rest[0] if rest else "build/bench")
         out.mkdir(parents=True, exist_ok=True)
         print(many_spheres(out, n, as_json))
+        return
+    one_of = {"--instances": instances, "--torus": torus_scene, "--lights": lights_scene, "--image": image_scene}
+    if args and args[0] in one_of:
+        value = float(args[1]) if args[0] == "--image" else int(args[1])
+        out = Path(args[2] if len(args) > 2 else "build/bench")
+        out.mkdir(parents=True, exist_ok=True)
+        result = one_of[args[0]](out, value)
+        for path in result if isinstance(result, list) else [result]:
+            print(path)
         return
     out = Path(sys.argv[1] if len(sys.argv) > 1 else "build/bench")
     names = set(sys.argv[2:]) or {"spheres", "torus100k", "torus1m"}

@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <optional>
 #include <stdexcept>
 
 namespace whitted::pov {
@@ -125,9 +126,71 @@ public:
         for (const auto& object : list) write(object, parent);
     }
 
+    /// Each prototype as POV-Ray shares it: every mesh2 of it `#declare`d once, in the
+    /// prototype's space and without a texture, so that each instance (`object { NAME ... }`)
+    /// gives its own texture and transform while POV-Ray keeps one copy of the triangles
+    /// (copies of a mesh share its data). Only prototypes that some instance places.
+    void prototype_declarations() {
+        const auto& prototypes = m_description.prototypes;
+        m_pieces.assign(prototypes.size(), {});
+        std::function<bool(const std::vector<ObjectDescription>&, const std::string&)> places =
+            [&](const auto& list, const std::string& name) {
+                for (const auto& object : list)
+                    if ((object.type == ObjectType::instance && object.prototype.value == name) ||
+                        places(object.children, name))
+                        return true;
+                return false;
+            };
+        for (size_t i = 0; i < prototypes.size(); ++i) {
+            if (!places(m_description.objects, prototypes[i].name)) continue;
+            m_out += "// prototype " + comment_safe(prototypes[i].name) + "\n";
+            m_collect = &m_pieces[i];
+            write(prototypes[i].object, Transform());
+            m_collect = nullptr;
+            for (size_t k = 0; k < m_pieces[i].size(); ++k) {
+                m_out += "#declare " + piece_name(i, k) + " =\n" + m_pieces[i][k].sdl;
+                m_pieces[i][k].sdl.clear();
+            }
+        }
+    }
+
 private:
+    /// One mesh2 of a prototype: its SDL (until declared) and its own material, if it has one.
+    struct Piece {
+        std::string sdl;
+        std::optional<Material> material;
+    };
+
+    static std::string piece_name(size_t prototype, size_t piece) {
+        return "whitted_prototype_" + std::to_string(prototype) + "_" + std::to_string(piece);
+    }
+
+    void instance(const ObjectDescription& object, const Transform& to_world) {
+        size_t index = 0;
+        while (m_description.prototypes[index].name != object.prototype.value) ++index;  // validate_scene checked it
+        const std::vector<Piece>& pieces = m_pieces[index];
+        const std::optional<Material> override =
+            object.material ? std::optional<Material>(material_of(object)) : std::nullopt;
+        const auto placed = [&](size_t k) {
+            return "object { " + piece_name(index, k) + "\n    " + texture(override ? *override : *pieces[k].material);
+        };
+        if (pieces.size() == 1) {
+            m_out += placed(0) + "\n   " + matrix(to_world) + " }\n";
+            return;
+        }
+        m_out += "union {\n";
+        for (size_t k = 0; k < pieces.size(); ++k) m_out += "  " + placed(k) + " }\n";
+        m_out += " " + matrix(to_world) + " }\n";
+    }
+
     static Material to_material(const MaterialDescription& d) {
         return {d.ka.value, d.kd.value, d.ks.value, d.p.value, d.km.value, d.highlight.value};
+    }
+
+    /// In a prototype a mesh may leave its material to the instances.
+    std::optional<Material> material_if_given(const ObjectDescription& object) const {
+        if (!object.material) return std::nullopt;
+        return material_of(object);
     }
 
     Material material_of(const ObjectDescription& object) const {
@@ -156,16 +219,19 @@ private:
                 break;
             }
             case ObjectType::triangle:
-                mesh(object.vertices, {}, {{0, 1, 2}}, to_world, material_of(object));
+                mesh(object.vertices, {}, {{0, 1, 2}}, to_world, material_if_given(object));
                 break;
             case ObjectType::mesh:
                 if (object.file.given)
                     mesh_file(object, to_world);
                 else
-                    mesh(object.vertices, object.normals, object.triangles, to_world, material_of(object));
+                    mesh(object.vertices, object.normals, object.triangles, to_world, material_if_given(object));
                 break;
             case ObjectType::group:
                 objects(object.children, to_world);
+                break;
+            case ObjectType::instance:
+                instance(object, to_world);
                 break;
         }
     }
@@ -187,7 +253,8 @@ private:
         }
         for (const auto& [m, triangles] : by_material) {
             const MaterialDescription* mtl = m >= 0 ? &data.materials[size_t(m)] : nullptr;
-            mesh(vertices, normals, triangles, to_world, mtl ? to_material(*mtl) : material_of(object));
+            mesh(vertices, normals, triangles, to_world,
+                 mtl ? std::optional<Material>(to_material(*mtl)) : material_if_given(object));
         }
     }
 
@@ -202,8 +269,11 @@ private:
     /// vertex Whitted uses.
     void mesh(const std::vector<Vec3>& vertices, const std::vector<Vec3>& normals,
               const std::vector<std::array<int64_t, 3>>& triangles, const Transform& to_world,
-              const Material& material) {
-        std::string& o = m_out;
+              const std::optional<Material>& material) {
+        // In a prototype (m_collect) the mesh2 goes to its piece, without a texture: each
+        // instance gives its own.
+        std::string piece;
+        std::string& o = m_collect ? piece : m_out;
         std::vector<Vec3> world;  // the float vertices, as doubles
         world.reserve(vertices.size());
         for (const Vec3& v : vertices) {
@@ -227,9 +297,11 @@ private:
         o += "  face_indices { " + std::to_string(triangles.size());
         for (const auto& t : triangles)
             o += ",\n    <" + std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " + std::to_string(t[2]) + ">";
-        o += " }\n  " + texture(material) + "\n";
+        o += " }\n";
+        if (!m_collect) o += "  " + texture(*material) + "\n";  // validate_scene checked it is there
         if (!(centre == Vec3(0.0))) o += "  translate " + vec(centre) + "\n";
         o += "}\n";
+        if (m_collect) m_collect->push_back({std::move(piece), material});
     }
 
     /// Per axis: a float near the vertices' middle, if the mesh is far out on that axis (beyond
@@ -253,6 +325,8 @@ private:
     const SceneDescription& m_description;
     std::string& m_out;
     std::map<std::string, Material> m_named;
+    std::vector<std::vector<Piece>> m_pieces;  ///< per prototype: its declared mesh2s
+    std::vector<Piece>* m_collect = nullptr;   ///< the prototype being declared, or null
 };
 
 double max_channel(const Color& c) {
@@ -272,6 +346,9 @@ double radiance_upper_bound(const SceneDescription& d) {
         }
     };
     collect(d.objects);
+    std::vector<ObjectDescription> prototype_objects;
+    for (const auto& prototype : d.prototypes) prototype_objects.push_back(prototype.object);
+    collect(prototype_objects);
     double local = 0, mirror = 0;
     for (const auto& m : materials) {
         local = std::max(local, max_channel(m.ka.value * d.ambient.value + (m.kd.value + m.ks.value) * light_sum));
@@ -284,7 +361,7 @@ double radiance_upper_bound(const SceneDescription& d) {
                 return true;
         return false;
     };
-    if (has_mtl(d.objects)) return INFINITY;
+    if (has_mtl(d.objects) || has_mtl(prototype_objects)) return INFINITY;
     const double background = max_channel(d.image.background.value);
     double bound = std::max(background, local);
     for (int64_t depth = 2; depth <= d.max_depth.value; ++depth) bound = std::max(background, local + mirror * bound);
@@ -336,6 +413,7 @@ static void refuse_inexpressible(const SceneDescription& d) {
         }
     };
     objects(d.objects);
+    for (const auto& prototype : d.prototypes) objects({prototype.object});
 }
 
 static std::string write_sdl(const SceneDescription& d, const ConvertOptions& options) {
@@ -368,6 +446,8 @@ static std::string write_sdl(const SceneDescription& d, const ConvertOptions& op
     // light_group POV-Ray first re-tests the object that last blocked the same light, accepting
     // it from t = 1e-4 instead of the 1e-3 its full shadow test (and Whitted) uses, so a pixel's
     // shadow would depend on which pixel POV-Ray shaded before it (docs/pov-model.md §3).
+    SdlWriter writer(d, o);
+    writer.prototype_declarations();
     const bool light_group = !d.lights.empty() && !d.objects.empty();
     if (light_group) o += "light_group {\n";
     for (const auto& light : d.lights) {
@@ -382,7 +462,6 @@ static std::string write_sdl(const SceneDescription& d, const ConvertOptions& op
                  rgb(intensity) + " parallel point_at <0, 0, 0> }\n";
         }
     }
-    SdlWriter writer(d, o);
     writer.objects(d.objects, Transform());
     if (light_group) o += "  global_lights off\n}\n";
     return o;

@@ -139,6 +139,9 @@ public:
                     out += in + "objects:" + (o.children.empty() ? " []\n" : "\n");
                     objects(o.children, in + "  ", out);
                     break;
+                case ObjectType::instance:
+                    out += in + "prototype: " + quoted(o.prototype.value) + "\n";
+                    break;
             }
         }
     }
@@ -179,6 +182,14 @@ std::string scene_to_yaml(const SceneDescription& scene, const std::string& outp
     }
     out += "materials:" + std::string(scene.materials.empty() ? " {}\n" : "\n");
     for (const MaterialDescription& m : scene.materials) out += "  " + quoted(m.name) + ": " + material_map(m) + "\n";
+    if (!scene.prototypes.empty()) {
+        // Each prototype as a group holding it: a map entry, written with the list writer.
+        out += "prototypes:\n";
+        for (const PrototypeDescription& p : scene.prototypes) {
+            out += "  " + quoted(p.name) + ":\n    type: group\n    objects:\n";
+            writer.objects({p.object}, "      ", out);
+        }
+    }
     out += "objects:" + std::string(scene.objects.empty() ? " []\n" : "\n");
     writer.objects(scene.objects, "  ", out);
     return out;

@@ -325,11 +325,11 @@ int run_render(const RenderArguments& args) {
             std::fprintf(
                 stderr,
                 "whitted: stages: read (parse, validate, load meshes) %.3fs, build BVH %.3fs, render %.3fs, write %.3fs; "
-                "%zu triangles, %zu spheres, %zu boxes, %zu planes, %zu lights; BVH %.1f MB (%.1f MB while "
-                "building); Embree %s, %d-wide packets\n",
-                impl.read_seconds, build_seconds, result.stats.seconds, write_seconds,
-                scene.triangle_count(), scene.spheres.size(), scene.boxes.size(), scene.planes.size(),
-                scene.lights.size(), double(accelerator.embree_bytes()) / 1e6,
+                "%zu triangles, %zu spheres, %zu boxes, %zu planes, %zu lights, %zu instances (%zu triangles seen); "
+                "BVH %.1f MB (%.1f MB while building); Embree %s, %d-wide packets\n",
+                impl.read_seconds, build_seconds, result.stats.seconds, write_seconds, scene.triangle_count(),
+                scene.spheres.size(), scene.boxes.size(), scene.planes.size(), scene.lights.size(),
+                scene.instances.size(), scene.instanced_triangle_count(), double(accelerator.embree_bytes()) / 1e6,
                 double(accelerator.peak_embree_bytes()) / 1e6,
                 accelerator.isa().empty() ? "(its choice)" : accelerator.isa().c_str(), accelerator.lane_width());
         if (!args.quiet)

@@ -290,5 +290,49 @@ TEST(Accelerator, GeometricNormalBesideTheShadingNormal) {
     EXPECT_DOUBLE_EQ(hit.normal.z, 1.0);
 }
 
+// An instance is its prototype under the transform, hit in double: a unit triangle in z = 0
+// placed by scale [2, 3, -1] (mirrored in z), then translate [10, 0, -4]. Closed form: the
+// world triangle is (10, 0, -4), (12, 0, -4), (10, 3, -4); a ray down -z from (10.5, 0.5, 5)
+// meets it at t = 9, point (10.5, 0.5, -4), face normal (v1 - v0) x (v2 - v0) of the world
+// vertices = (0, 0, 6), unit +z, as a plain copy's. The hit takes the instance's object number
+// and material (the override), and a second instance without override its own member's.
+TEST(Accelerator, InstanceHitIsThePlacedPrototypes) {
+    const Scene scene = test::scene_from(test::join_lines({
+        "camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}",
+        "image: {width: 8, height: 8}",
+        "materials: {red: {kd: [1, 0, 0]}, grey: {kd: 0.5}}",
+        "prototypes:",
+        "  tri: {type: triangle, material: grey, vertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]]}",
+        "objects:",
+        "  - {type: sphere, center: [-10, 0, 0], radius: 1, material: grey}",
+        "  - {type: instance, prototype: tri, material: red,",
+        "     transform: [{scale: [2, 3, -1]}, {translate: [10, 0, -4]}]}",
+        "  - {type: instance, prototype: tri, transform: {translate: [20, 0, 0]}}",
+    }));
+    ASSERT_EQ(scene.instances.size(), 2u);
+    EXPECT_EQ(scene.triangle_count(), 1u);
+    EXPECT_EQ(scene.instanced_triangle_count(), 2u);
+    const Accelerator accelerator(scene, 1);
+    SurfaceHit hit;
+    ASSERT_TRUE(accelerator.intersect({{10.5, 0.5, 5}, {0, 0, -1}, 1e-4, 1e7}, hit));
+    EXPECT_DOUBLE_EQ(hit.t, 9.0);
+    EXPECT_DOUBLE_EQ(hit.point.x, 10.5);
+    EXPECT_DOUBLE_EQ(hit.point.y, 0.5);
+    EXPECT_DOUBLE_EQ(hit.point.z, -4.0);
+    EXPECT_DOUBLE_EQ(hit.geometric_normal.z, 1.0);
+    EXPECT_DOUBLE_EQ(hit.normal.z, 1.0);
+    EXPECT_EQ(hit.object, 2u);
+    EXPECT_EQ(scene.material_names[hit.material], "red");
+    // Outside the placed triangle (x = 12.5 lies beyond the scaled edge): nothing.
+    EXPECT_FALSE(accelerator.intersect({{12.5, 0.5, 5}, {0, 0, -1}, 1e-4, 1e7}, hit));
+    ASSERT_TRUE(accelerator.intersect({{20.25, 0.25, 5}, {0, 0, -1}, 1e-4, 1e7}, hit));
+    EXPECT_DOUBLE_EQ(hit.t, 5.0);
+    EXPECT_EQ(hit.object, 3u);
+    EXPECT_EQ(scene.material_names[hit.material], "grey");
+    const Ray shadow{{10.5, 0.5, 5}, {0, 0, -1}, 1e-3, 8.5};
+    EXPECT_FALSE(accelerator.occluded(shadow));
+    EXPECT_TRUE(accelerator.occluded({{10.5, 0.5, 5}, {0, 0, -1}, 1e-3, 9.5}));
+}
+
 }  // namespace
 }  // namespace whitted

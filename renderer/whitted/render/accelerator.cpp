@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <deque>
 #include <limits>
 #include <mutex>
 #include <stdexcept>
@@ -19,7 +20,14 @@
 namespace whitted {
 namespace {
 
-enum class ShapeKind : uint32_t { triangles, spheres, boxes };
+enum class ShapeKind : uint32_t { triangles, spheres, boxes, instances };
+
+/// A ray taken into an instance's prototype space, in double. The direction is not
+/// renormalised, so t along it is the world t: ranges and distances carry over unchanged.
+Ray to_object_space(const Ray& ray, const Transform& object_to_world) {
+    return {object_to_world.inverse_point(ray.origin), object_to_world.inverse_vector(ray.direction), ray.t_min,
+            ray.t_max};
+}
 
 /// Embree's context, extended with the double-precision rays of the query: user-geometry
 /// callbacks read them back from the pointer Embree passes them (Embree's ray `id` is the index
@@ -136,14 +144,25 @@ Vec3 vertex(const TriangleMesh& mesh, uint32_t index) {
 /// (EmbreeFrame::exact_range). Only the range: whether the ray passes inside the triangle's
 /// edges stays Embree's decision, so a ray through an edge two triangles share is decided as
 /// before.
+/// What triangle_filter needs of a mesh: its triangles and, for a prototype's mesh, the
+/// transform of each instance (by Embree's instance geomID), to take the ray into its space.
+struct TriangleGeometry {
+    const TriangleMesh* mesh = nullptr;
+    const std::vector<const Transform*>* instance_transforms = nullptr;
+};
+
 void triangle_filter(const RTCFilterFunctionNArguments* args) {
-    const auto* mesh = static_cast<const TriangleMesh*>(args->geometryUserPtr);
+    const auto* geometry = static_cast<const TriangleGeometry*>(args->geometryUserPtr);
+    const TriangleMesh* mesh = geometry->mesh;
     const auto* context = reinterpret_cast<const QueryContext*>(args->context);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
         const unsigned id = RTCRayN_id(args->ray, args->N, i);
         if (!context->is_query(id)) continue;
-        const Ray& ray = context->rays[id];
+        const unsigned inst = RTCHitN_instID(args->hit, args->N, i, 0);
+        const Ray ray = inst == RTC_INVALID_GEOMETRY_ID
+                            ? context->rays[id]
+                            : to_object_space(context->rays[id], *(*geometry->instance_transforms)[inst]);
         const uint32_t* index = &mesh->indices[3 * size_t(RTCHitN_primID(args->hit, args->N, i))];
         ShapeHit hit;
         if (!hit_triangle_plane(vertex(*mesh, index[0]), vertex(*mesh, index[1]), vertex(*mesh, index[2]), ray, hit) ||
@@ -388,9 +407,15 @@ struct Accelerator::Impl {
     MemoryCount memory;
     RTCDevice device = nullptr;
     RTCScene rtc_scene = nullptr;
-    // geomID → what it is: a mesh index, or the sphere/box user geometry.
+    // geomID → what it is: a mesh index, the sphere/box user geometry, or an instance index.
     std::vector<ShapeKind> kinds;
     std::vector<uint32_t> mesh_of_geometry;
+    /// One Embree scene (one BVH) per prototype, placed by the instances; within each, a mesh's
+    /// geomID is its index in Prototype::meshes.
+    std::vector<RTCScene> prototype_scenes;
+    /// Top-level geomID → the instance's transform (null for other geometry), for triangle_filter.
+    std::vector<const Transform*> instance_transforms;
+    std::deque<TriangleGeometry> filter_data;  ///< triangle_filter's user data, one per mesh (stable addresses)
     AnalyticGeometry spheres{ShapeKind::spheres, nullptr, {}};
     AnalyticGeometry boxes{ShapeKind::boxes, nullptr, {}};
     RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;  ///< of the scene and its meshes (build_quality)
@@ -415,7 +440,11 @@ struct Accelerator::Impl {
         rtcSetSceneBuildQuality(rtc_scene, quality);
         frame = choose_frame();
         spheres.offset = boxes.offset = frame.offset;
-        for (uint32_t m = 0; m < scene.meshes.size(); ++m) add_mesh(m);
+        for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
+            const unsigned id = add_mesh(rtc_scene, scene.meshes[m], Vec3(0.0) - frame.offset);
+            record(id, ShapeKind::triangles, m);
+        }
+        add_instances();
         if (!scene.spheres.empty()) add_analytic(spheres, scene.spheres.size());
         if (!scene.boxes.empty()) add_analytic(boxes, scene.boxes.size());
         rtcCommitScene(rtc_scene);
@@ -437,8 +466,7 @@ struct Accelerator::Impl {
     /// So LOW once the triangles outnumber a quarter of the camera rays. The BVH only changes
     /// the order in which candidates are met: the 1M-triangle image came out bit-identical.
     RTCBuildQuality build_quality() const {
-        size_t triangles = 0;
-        for (const TriangleMesh& mesh : scene.meshes) triangles += mesh.triangle_count();
+        const size_t triangles = scene.triangle_count();
         const double camera_rays = double(scene.width) * scene.height * scene.samples * scene.samples;
         return double(triangles) > camera_rays / 4 ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM;
     }
@@ -470,6 +498,27 @@ struct Accelerator::Impl {
             world_bounds(box, a, b);
             lo = min(lo, a), hi = max(hi, b);
         }
+        // An instance's float errors come from Embree's world-space ray (the frame's reach) and
+        // from its prototype-space triangles, which the transform scales (at most by the largest
+        // absolute row sum of its linear part).
+        double local_reach = 0;
+        for (const Instance& instance : scene.instances) {
+            const Prototype& prototype = scene.prototypes[instance.prototype];
+            for (int corner = 0; corner < 8; ++corner) {
+                const Vec3 p = instance.object_to_world.apply_point({corner & 1 ? prototype.hi.x : prototype.lo.x,
+                                                                     corner & 2 ? prototype.hi.y : prototype.lo.y,
+                                                                     corner & 4 ? prototype.hi.z : prototype.lo.z});
+                lo = min(lo, p), hi = max(hi, p);
+            }
+            const auto& m = instance.object_to_world.rows();
+            double norm = 0;
+            for (int row = 0; row < 3; ++row)
+                norm = std::max(norm, std::fabs(m[4 * row]) + std::fabs(m[4 * row + 1]) + std::fabs(m[4 * row + 2]));
+            local_reach =
+                std::max({local_reach, norm * std::max({std::fabs(prototype.lo.x), std::fabs(prototype.lo.y),
+                                                        std::fabs(prototype.lo.z), std::fabs(prototype.hi.x),
+                                                        std::fabs(prototype.hi.y), std::fabs(prototype.hi.z)})});
+        }
         EmbreeFrame chosen;
         if (!(lo.x <= hi.x)) return chosen;  // no finite shape: Embree has nothing to find
         const Vec3 centre = (lo + hi) * 0.5, half = (hi - lo) * 0.5;
@@ -477,23 +526,28 @@ struct Accelerator::Impl {
         const double size = std::max({half.x, half.y, half.z});
         if (std::isfinite(far) && far > size) chosen.offset = centre;
         const Vec3 a = lo - chosen.offset, b = hi - chosen.offset;
-        const double reach =
-            std::max({std::fabs(a.x), std::fabs(a.y), std::fabs(a.z), std::fabs(b.x), std::fabs(b.y), std::fabs(b.z)});
+        const double reach = std::max({std::fabs(a.x), std::fabs(a.y), std::fabs(a.z), std::fabs(b.x), std::fabs(b.y),
+                                       std::fabs(b.z), local_reach});
         chosen.exact_range = !(16 * std::ldexp(reach, -23) < ray_limits::surface_t_min / 4);
         return chosen;
     }
 
     void release() {
         if (rtc_scene) rtcReleaseScene(rtc_scene);
+        for (RTCScene prototype : prototype_scenes) rtcReleaseScene(prototype);
+        prototype_scenes.clear();
         if (device) rtcReleaseDevice(device);
         rtc_scene = nullptr;
         device = nullptr;
     }
 
-    void add_mesh(uint32_t m) {
-        const TriangleMesh& mesh = scene.meshes[m];
+    /// Attaches a triangle mesh to `target` with its vertices moved by `shift` (Embree's
+    /// coordinates: the world minus the frame's offset; a prototype's own, unshifted). Returns
+    /// its geomID there.
+    unsigned add_mesh(RTCScene target, const TriangleMesh& mesh, const Vec3& shift,
+                      const std::vector<const Transform*>* transforms = nullptr) {
         RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        if (frame.offset == Vec3(0.0)) {
+        if (shift == Vec3(0.0)) {
             // Shared buffers: Embree reads the scene's own arrays, no copy (positions are padded to 16 bytes).
             rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.positions.data(), 0,
                                        4 * sizeof(float), mesh.vertex_count());
@@ -501,7 +555,7 @@ struct Accelerator::Impl {
             auto* local = static_cast<float*>(rtcSetNewGeometryBuffer(
                 geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 4 * sizeof(float), mesh.vertex_count()));
             for (uint32_t i = 0; i < mesh.vertex_count(); ++i) {
-                const Vec3 p = vertex(mesh, i) - frame.offset;
+                const Vec3 p = vertex(mesh, i) + shift;
                 local[4 * size_t(i)] = float(p.x);
                 local[4 * size_t(i) + 1] = float(p.y);
                 local[4 * size_t(i) + 2] = float(p.z);
@@ -512,14 +566,49 @@ struct Accelerator::Impl {
                                    3 * sizeof(uint32_t), mesh.triangle_count());
         rtcSetGeometryBuildQuality(geometry, quality);  // Embree builds LOW only if both say so
         if (frame.exact_range) {
-            rtcSetGeometryUserData(geometry, const_cast<TriangleMesh*>(&mesh));
+            filter_data.push_back({&mesh, transforms});
+            rtcSetGeometryUserData(geometry, &filter_data.back());
             rtcSetGeometryIntersectFilterFunction(geometry, triangle_filter);
             rtcSetGeometryOccludedFilterFunction(geometry, triangle_filter);
         }
         rtcCommitGeometry(geometry);
-        const unsigned id = rtcAttachGeometry(rtc_scene, geometry);
+        const unsigned id = rtcAttachGeometry(target, geometry);
         rtcReleaseGeometry(geometry);
-        record(id, ShapeKind::triangles, m);
+        return id;
+    }
+
+    /// One Embree scene per prototype, built once, and one Embree instance per placement: the
+    /// triangles are stored (and their BVH built) once however many times they are placed.
+    /// Embree holds each instance's transform in float, with the frame's offset taken off; it
+    /// only proposes candidates, and finish_hit decides each in double from the scene's own
+    /// transform.
+    void add_instances() {
+        if (scene.instances.empty()) return;
+        for (const Prototype& prototype : scene.prototypes) {
+            RTCScene prototype_scene = rtcNewScene(device);
+            prototype_scenes.push_back(prototype_scene);
+            rtcSetSceneBuildQuality(prototype_scene, quality);
+            for (const TriangleMesh& mesh : prototype.meshes)
+                add_mesh(prototype_scene, mesh, Vec3(0.0), &instance_transforms);
+            rtcCommitScene(prototype_scene);
+        }
+        for (uint32_t i = 0; i < scene.instances.size(); ++i) {
+            const Instance& instance = scene.instances[i];
+            RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+            rtcSetGeometryInstancedScene(geometry, prototype_scenes[instance.prototype]);
+            rtcSetGeometryTimeStepCount(geometry, 1);
+            const auto& m = instance.object_to_world.rows();
+            const float rows[12] = {float(m[0]), float(m[1]), float(m[2]),  float(m[3] - frame.offset.x),
+                                    float(m[4]), float(m[5]), float(m[6]),  float(m[7] - frame.offset.y),
+                                    float(m[8]), float(m[9]), float(m[10]), float(m[11] - frame.offset.z)};
+            rtcSetGeometryTransform(geometry, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, rows);
+            rtcCommitGeometry(geometry);
+            const unsigned id = rtcAttachGeometry(rtc_scene, geometry);
+            rtcReleaseGeometry(geometry);
+            record(id, ShapeKind::instances, i);
+            if (instance_transforms.size() <= id) instance_transforms.resize(id + 1, nullptr);
+            instance_transforms[id] = &instance.object_to_world;
+        }
     }
 
     void add_analytic(AnalyticGeometry& user, size_t count) {
@@ -541,22 +630,48 @@ struct Accelerator::Impl {
         mesh_of_geometry[id] = mesh;
     }
 
-    /// The shading normal at a triangle hit: the face normal, or for smooth meshes the unit
-    /// vertex normals blended by barycentric weight and renormalised, as POV-Ray's mesh2 does
-    /// (it falls back to the face normal when the three vertex normals are equal, except under
-    /// render.convention: course).
-    Vec3 triangle_normal(const TriangleMesh& mesh, uint32_t prim, const ShapeHit& hit) const {
-        if (mesh.normals.empty()) return normalize(hit.normal);
+    /// The smooth shading normal at a triangle hit: the unit vertex normals blended by
+    /// barycentric weight and renormalised, as POV-Ray's mesh2 does. False where the triangle
+    /// is shaded flat, with its face normal: a mesh without normals, three equal vertex normals
+    /// (except under render.convention: course) or a blend of length 0.
+    bool blended_normal(const TriangleMesh& mesh, uint32_t prim, const ShapeHit& hit, Vec3& out) const {
+        if (mesh.normals.empty()) return false;
         const uint32_t* index = &mesh.indices[3 * size_t(prim)];
         const Vec3 n0 = vertex_normal(mesh, index[0]), n1 = vertex_normal(mesh, index[1]),
                    n2 = vertex_normal(mesh, index[2]);
         const Vec3 d1 = n0 - n1, d2 = n0 - n2;
         // The course's convention interpolates always, as its ray tracer does.
-        if (dot(d1, d1) <= 1e-10 && dot(d2, d2) <= 1e-10 && scene.convention != Convention::course)
-            return normalize(hit.normal);
+        if (dot(d1, d1) <= 1e-10 && dot(d2, d2) <= 1e-10 && scene.convention != Convention::course) return false;
         const Vec3 blended = n0 * (1.0 - hit.u - hit.v) + n1 * hit.u + n2 * hit.v;
         const double len = length(blended);
-        return len > 0 ? blended / len : normalize(hit.normal);
+        if (!(len > 0)) return false;
+        out = blended / len;
+        return true;
+    }
+
+    /// The exact hit on triangle `prim` of `mesh` for a candidate Embree found (u, v, t and
+    /// its normal: Embree's, for a ray parallel to the plane in double). False with `retry`
+    /// set when the double ray meets its plane outside the range (see finish_hit).
+    static bool exact_triangle_hit(const TriangleMesh& mesh, unsigned prim, const Ray& ray, float u, float v, float t,
+                                   const Vec3& embree_normal, ShapeHit& hit, bool& retry) {
+        const uint32_t* index = &mesh.indices[3 * size_t(prim)];
+        const Vec3 v0 = vertex(mesh, index[0]), v1 = vertex(mesh, index[1]), v2 = vertex(mesh, index[2]);
+        const bool inside = intersect_triangle(v0, v1, v2, ray, ray.t_min, ray.t_max, hit);
+        if (!inside && hit_triangle_plane(v0, v1, v2, ray, hit) && !(hit.t > ray.t_min && hit.t < ray.t_max)) {
+            retry = true;
+            return false;
+        }
+        if (!inside && !hit_triangle_plane(v0, v1, v2, ray, hit)) {
+            // Float and double disagree on an edge: the hit is taken where the double ray
+            // meets the triangle's plane (hit_triangle_plane), not from Embree's float
+            // numbers, which differ in the last bits from one instruction set to another.
+            // Only a ray parallel to the plane in double is left with Embree's answer.
+            hit.t = t;
+            hit.u = u;
+            hit.v = v;
+            hit.normal = embree_normal;
+        }
+        return true;
     }
 
     /// The exact hit for what Embree found on one ray (geom == invalid: nothing), then the planes.
@@ -565,34 +680,41 @@ struct Accelerator::Impl {
     /// start on (or within rounding of) a neighbouring triangle's plane, which Embree's float
     /// distance puts past t_min while in double it is 0, behind the ray or too near. Such a
     /// candidate is no hit; the caller traces the ray again beyond it (intersect_beyond).
-    bool finish_hit(const Ray& ray, unsigned geom, unsigned prim, float u, float v, float t, const Vec3& embree_normal,
-                    double best_t, const Vec3& best_normal, SurfaceHit& out, bool& retry) const {
+    /// `inst`: Embree's instance geomID when the candidate is a prototype's triangle (`geom` is
+    /// then its mesh in the prototype), else RTC_INVALID_GEOMETRY_ID.
+    bool finish_hit(const Ray& ray, unsigned inst, unsigned geom, unsigned prim, float u, float v, float t,
+                    const Vec3& embree_normal, double best_t, const Vec3& best_normal, SurfaceHit& out,
+                    bool& retry) const {
         retry = false;
         bool found = false;
         double t_max = ray.t_max;
         ShapeHit hit;
         if (geom != RTC_INVALID_GEOMETRY_ID) {
-            if (kinds[geom] == ShapeKind::triangles) {
-                const TriangleMesh& mesh = scene.meshes[mesh_of_geometry[geom]];
-                const uint32_t* index = &mesh.indices[3 * size_t(prim)];
-                const Vec3 v0 = vertex(mesh, index[0]), v1 = vertex(mesh, index[1]), v2 = vertex(mesh, index[2]);
-                const bool inside = intersect_triangle(v0, v1, v2, ray, ray.t_min, ray.t_max, hit);
-                if (!inside && hit_triangle_plane(v0, v1, v2, ray, hit) && !(hit.t > ray.t_min && hit.t < ray.t_max)) {
-                    retry = true;
+            if (inst != RTC_INVALID_GEOMETRY_ID) {
+                // A prototype's triangle, tested in double in the prototype's space (Embree's
+                // normal is in that space too), its normals then taken to the world with the
+                // inverse transpose. A plain copy's face normal is (v1 − v0) × (v2 − v0) of the
+                // world vertices, which is the transformed one times the sign of the determinant.
+                const Instance& instance = scene.instances[mesh_of_geometry[inst]];
+                const Transform& to_world = instance.object_to_world;
+                const TriangleMesh& mesh = scene.prototypes[instance.prototype].meshes[geom];
+                if (!exact_triangle_hit(mesh, prim, to_object_space(ray, to_world), u, v, t, embree_normal, hit, retry))
                     return false;
-                }
-                if (!inside && !hit_triangle_plane(v0, v1, v2, ray, hit)) {
-                    // Float and double disagree on an edge: the hit is taken where the double ray
-                    // meets the triangle's plane (hit_triangle_plane), not from Embree's float
-                    // numbers, which differ in the last bits from one instruction set to another.
-                    // Only a ray parallel to the plane in double is left with Embree's answer.
-                    hit.t = t;
-                    hit.u = u;
-                    hit.v = v;
-                    hit.normal = embree_normal;
-                }
+                const double handedness = to_world.determinant() < 0 ? -1.0 : 1.0;
+                out.geometric_normal = normalize(to_world.apply_normal(hit.normal)) * handedness;
+                Vec3 smooth;
+                out.normal = blended_normal(mesh, prim, hit, smooth) ? normalize(to_world.apply_normal(smooth))
+                                                                     : out.geometric_normal;
+                out.material = instance.material != Instance::no_material ? instance.material
+                               : mesh.triangle_materials.empty()          ? mesh.material
+                                                                          : mesh.triangle_materials[prim];
+                out.object = instance.object;
+            } else if (kinds[geom] == ShapeKind::triangles) {
+                const TriangleMesh& mesh = scene.meshes[mesh_of_geometry[geom]];
+                if (!exact_triangle_hit(mesh, prim, ray, u, v, t, embree_normal, hit, retry)) return false;
                 out.geometric_normal = normalize(hit.normal);
-                out.normal = mesh.normals.empty() ? out.geometric_normal : triangle_normal(mesh, prim, hit);
+                Vec3 smooth;
+                out.normal = blended_normal(mesh, prim, hit, smooth) ? smooth : out.geometric_normal;
                 out.material = mesh.triangle_materials.empty() ? mesh.material : mesh.triangle_materials[prim];
                 out.object = mesh.object;
             } else {
@@ -640,15 +762,17 @@ struct Accelerator::Impl {
             rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
             rtcIntersect1(rtc_scene, &context.embree, &rayhit);
             bool retry = false;
-            const bool found = finish_hit(ray, rayhit.hit.geomID, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v,
-                                          rayhit.ray.tfar, {rayhit.hit.Ng_x, rayhit.hit.Ng_y, rayhit.hit.Ng_z},
-                                          context.best_t[0], context.best_normal[0], out, retry);
+            const bool found =
+                finish_hit(ray, rayhit.hit.instID[0], rayhit.hit.geomID, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v,
+                           rayhit.ray.tfar, {rayhit.hit.Ng_x, rayhit.hit.Ng_y, rayhit.hit.Ng_z}, context.best_t[0],
+                           context.best_normal[0], out, retry);
             // A bounded number of refusals in a row (a fan of grazing neighbours); past it the
             // planes alone answer, as if the triangles had been missed.
             if (!retry) return found;
             rejected = rayhit.ray.tfar;
             if (attempt == max_refused_candidates)
-                return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, 0, 0, 0, 0, {}, 0, {}, out, retry);
+                return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, 0, 0, {}, 0, {}, out,
+                                  retry);
         }
     }
     static constexpr int max_refused_candidates = 8;
@@ -661,7 +785,12 @@ struct Accelerator::Impl {
         const auto groups = [&]<int W>() {
             for (int first = 0; first < count; first += W) lanes.template operator()<W>(first);
         };
-        switch (lane_width) {
+        // With instances, 8 lanes at most: Embree 3.13.5's 16-wide (AVX-512) occlusion traversal
+        // of instances did not return on our CPU (the render of tests/pov/instance_placements.yaml
+        // hung inside rtcOccluded16), while its 8-wide one, on the same device, is right. Only the
+        // grouping changes; every answer is recomputed in double, so the pixels do not.
+        const int width = lane_width == 16 && !scene.instances.empty() ? 8 : lane_width;
+        switch (width) {
             case 16:
                 groups.template operator()<16>();
                 return true;
@@ -704,8 +833,8 @@ struct Accelerator::Impl {
             const int i = first + lane;
             if (!valid[lane]) continue;
             bool retry = false;
-            found[i] = finish_hit(rays[i], packet.hit.geomID[lane], packet.hit.primID[lane], packet.hit.u[lane],
-                                  packet.hit.v[lane], packet.ray.tfar[lane],
+            found[i] = finish_hit(rays[i], packet.hit.instID[0][lane], packet.hit.geomID[lane], packet.hit.primID[lane],
+                                  packet.hit.u[lane], packet.hit.v[lane], packet.ray.tfar[lane],
                                   {packet.hit.Ng_x[lane], packet.hit.Ng_y[lane], packet.hit.Ng_z[lane]},
                                   context.best_t[i], context.best_normal[i], hits[i], retry);
             if (retry) found[i] = intersect_beyond(rays[i], packet.ray.tfar[lane], hits[i]);

@@ -132,7 +132,9 @@ struct TransformStep {
     std::array<double, 16> matrix{};  ///< matrix: row-major 4x4
 };
 
-enum class ObjectType { sphere, plane, box, triangle, mesh, group };
+/// `instance`: a placement of a prototype (SceneDescription::prototypes), declared once and
+/// shared by every placement (docs/scene-format.md §3.8).
+enum class ObjectType { sphere, plane, box, triangle, mesh, group, instance };
 
 struct ObjectDescription {
     SourceLocation where;
@@ -163,6 +165,16 @@ struct ObjectDescription {
     std::string file_path;      ///< resolved against the scene file's directory
     // group
     std::vector<ObjectDescription> children;
+    // instance: the name of an entry in `prototypes`
+    Located<std::string> prototype;
+};
+
+/// `prototypes:` entry: a mesh, triangle or group of them, declared once in a space of its own
+/// and placed by `instance` objects, each with its own transform and optionally its own material.
+struct PrototypeDescription {
+    SourceLocation where;  ///< the name's key
+    std::string name;
+    ObjectDescription object;
 };
 
 struct SceneDescription {
@@ -179,8 +191,10 @@ struct SceneDescription {
     std::vector<LightDescription> lights;
     std::vector<MaterialDescription> materials;  ///< in file order
     std::vector<ObjectDescription> objects;
+    std::vector<PrototypeDescription> prototypes;  ///< in file order
 
     const MaterialDescription* find_material(const std::string& name) const;
+    const PrototypeDescription* find_prototype(const std::string& name) const;
 };
 
 /// Limits that keep a hostile or mistaken scene from exhausting the machine; each is reported

@@ -426,11 +426,12 @@ ObjectDescription parse_object(ParseContext& ctx, const Node& node, const std::s
     if (!node.IsMap()) ctx.fail(node, what + ": expected a map with 'type', got " + describe(node));
     const Node type_node = node["type"];
     if (!type_node)
-        ctx.fail(node, what + ": missing required key 'type' (sphere, plane, box, triangle, mesh or group)");
+        ctx.fail(node, what + ": missing required key 'type' (sphere, plane, box, triangle, mesh, group or instance)");
     ObjectDescription object;
     static const std::vector<std::pair<std::string, ObjectType>> object_types = {
         {"sphere", ObjectType::sphere},     {"plane", ObjectType::plane}, {"box", ObjectType::box},
-        {"triangle", ObjectType::triangle}, {"mesh", ObjectType::mesh},   {"group", ObjectType::group}};
+        {"triangle", ObjectType::triangle}, {"mesh", ObjectType::mesh},   {"group", ObjectType::group},
+        {"instance", ObjectType::instance}};
     object.type = parse_choice<ObjectType>(ctx, type_node, what + ".type", object_types);
     // The keys each type takes: type, transform, material (not for groups), then its own.
     std::array<std::string_view, MapReader::max_keys> keys{"type", "transform"};
@@ -457,6 +458,9 @@ ObjectDescription parse_object(ParseContext& ctx, const Node& node, const std::s
             break;
         case ObjectType::group:
             allow({"objects"});
+            break;
+        case ObjectType::instance:
+            allow({"prototype"});
             break;
     }
     MapReader map(ctx, node, what + " (" + to_string(object.type) + ")", keys.data(), key_count);
@@ -536,6 +540,10 @@ ObjectDescription parse_object(ParseContext& ctx, const Node& node, const std::s
             object.children = parse_objects(ctx, children, label + ".objects", depth + 1);
             break;
         }
+        case ObjectType::instance:
+            // Resolved in validation, where every prototype is known (they may come after `objects`).
+            map.read(object.prototype, "prototype", parse_string, true);
+            break;
     }
     return object;
 }
@@ -566,7 +574,7 @@ SceneDescription parse_document(ParseContext& ctx, const Node& root) {
     if (!root || root.IsNull())
         throw InputError({ctx.file, 1, 1}, "the scene is empty: expected a map with 'camera', 'image' and 'objects'");
     MapReader map(ctx, root, "scene",
-                  {"version", "camera", "image", "render", "ambient", "lights", "materials", "objects"});
+                  {"version", "camera", "image", "render", "ambient", "lights", "materials", "prototypes", "objects"});
     SceneDescription scene;
     scene.path = ctx.file;
     map.integer(scene.version, "version");
@@ -610,6 +618,24 @@ SceneDescription parse_document(ParseContext& ctx, const Node& root) {
             }
         }
     }
+    if (map.has("prototypes")) {
+        const Node prototypes = map.get("prototypes");
+        if (!prototypes.IsNull()) {
+            if (!prototypes.IsMap())
+                ctx.fail(prototypes, "prototypes: expected a map of name: object, got " + describe(prototypes));
+            for (const auto& entry : prototypes.pairs()) {
+                if (!entry.first.IsScalar() || entry.first.Scalar().empty())
+                    ctx.fail(entry.first, "prototypes: names must be plain, non-empty words");
+                PrototypeDescription prototype;
+                prototype.name = entry.first.Scalar();
+                prototype.where = ctx.at(entry.first);
+                if (scene.find_prototype(prototype.name))
+                    ctx.fail(entry.first, "prototypes: '" + printable(prototype.name) + "' is defined twice");
+                prototype.object = parse_object(ctx, entry.second, "prototypes." + prototype.name, 0);
+                scene.prototypes.push_back(std::move(prototype));
+            }
+        }
+    }
     if (map.has("objects")) scene.objects = parse_objects(ctx, map.get("objects"), "objects", 0);
     return scene;
 }
@@ -619,6 +645,12 @@ SceneDescription parse_document(ParseContext& ctx, const Node& root) {
 const MaterialDescription* SceneDescription::find_material(const std::string& name) const {
     for (const auto& material : materials)
         if (material.name == name) return &material;
+    return nullptr;
+}
+
+const PrototypeDescription* SceneDescription::find_prototype(const std::string& name) const {
+    for (const auto& prototype : prototypes)
+        if (prototype.name == name) return &prototype;
     return nullptr;
 }
 
@@ -636,6 +668,8 @@ const char* to_string(ObjectType type) {
             return "mesh";
         case ObjectType::group:
             return "group";
+        case ObjectType::instance:
+            return "instance";
     }
     return "object";
 }

@@ -90,9 +90,28 @@ struct TriangleMesh {
     size_t vertex_count() const { return positions.size() / 4; }
 };
 
+/// A prototype (docs/scene-format.md §3.8): triangles in a space of their own, stored once and
+/// shared by all its instances (Embree builds one BVH for it). A mesh whose `material` is
+/// no_material takes each instance's.
+struct Prototype {
+    std::string name;
+    std::vector<TriangleMesh> meshes;  ///< in the prototype's space; TriangleMesh::object is unused (0)
+    Vec3 lo, hi;                       ///< bounds of the vertices, prototype space
+};
+
+/// One placement of a prototype: its transform and, if the instance names one, the material
+/// that replaces every material of the prototype's triangles.
+struct Instance {
+    static constexpr uint32_t no_material = 0xFFFFFFFFu;
+    Transform object_to_world;
+    uint32_t prototype = 0;           ///< Scene::prototypes index
+    uint32_t material = no_material;  ///< the override, or no_material: the prototype's own
+    uint32_t object = 0;              ///< Scene::objects index + 1
+};
+
 /// A shape as the scene file wrote it: sphere, plane, box, triangle or mesh (groups are not
-/// objects; their members are). Numbered 1, 2, ... in file order, depth first through groups:
-/// the `objectId` layer and `whitted explain` use these numbers (0 = nothing hit).
+/// objects; their members are; an instance is one object, whatever its prototype holds). Numbered 1, 2, ... in file
+/// order, depth first through groups: the `objectId` layer and `whitted explain` use these numbers (0 = nothing hit).
 struct SceneObject {
     ObjectType type = ObjectType::sphere;
     SourceLocation where;
@@ -118,8 +137,13 @@ struct Scene {
     std::vector<Plane> planes;
     std::vector<TriangleMesh> meshes;
     std::vector<std::string> mesh_files;  ///< the mesh files read, as resolved paths
+    std::vector<Prototype> prototypes;
+    std::vector<Instance> instances;
 
+    /// Triangles stored: each prototype's once, however many instances place it.
     size_t triangle_count() const;
+    /// Triangles as seen: each instance counts its prototype's triangles.
+    size_t instanced_triangle_count() const;
 };
 
 /// Checks every value of a description and builds the scene (loading mesh files). Throws

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <exception>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <string_view>
@@ -78,50 +79,97 @@ public:
         }
     }
 
-    void finish(const std::vector<MaterialDescription>& named) {
-        std::unordered_map<std::string_view, uint32_t> index;
+    /// The rest, once the whole file is read: the named materials (placed first), the prototypes,
+    /// the instances' prototypes, then the first mistake among the objects, then the renumbering.
+    void finish(const SceneDescription& d) {
         std::vector<std::string> names;
-        for (const auto& material : named) {
-            index.emplace(material.name, static_cast<uint32_t>(m_scene.materials.size()));
+        for (const auto& material : d.materials) {
+            m_named_index.emplace(material.name, static_cast<uint32_t>(m_scene.materials.size()));
             m_scene.materials.push_back(make_material(material, "materials." + material.name));
             m_scene.material_names.push_back(material.name);
             names.push_back(material.name);
         }
-        std::vector<uint32_t> final_index(m_uses.size());
-        for (size_t i = 0; i < m_uses.size(); ++i) {
-            const NameUse& use = m_uses[i];
-            const auto it = index.find(use.name);
-            if (it != index.end()) {
-                final_index[i] = it->second;
-                continue;
+        const size_t object_uses = m_uses.size();  // the prototypes' are checked as they are met
+        m_names_known = &names;
+        add_prototypes(d.prototypes);
+
+        // The first mistake in the objects, in the order they were met: one kept by
+        // add_top_level, an unknown material name, or an instance's prototype.
+        uint64_t first_step = m_error ? m_error_step : UINT64_MAX;
+        std::exception_ptr first = m_error;
+        for (size_t i = 0; i < object_uses; ++i)
+            if (!m_named_index.count(m_uses[i].name)) {
+                if (m_uses[i].step < first_step) {
+                    try {
+                        fail_unknown_material(m_uses[i], names);
+                    } catch (const InputError&) {
+                        first = std::current_exception(), first_step = m_uses[i].step;
+                    }
+                }
+                break;
             }
-            if (m_error && m_error_step < use.step) break;  // an earlier mistake is reported below
-            std::string known;
-            for (const auto& name : names) known += (known.empty() ? "" : ", ") + name;
-            fail(use.where, use.kind + ": unknown material '" + printable(use.name) + "'" +
-                                did_you_mean(use.name, names) +
-                                (known.empty() ? "; the scene defines no materials" : "; defined: " + known));
+        for (PendingInstance& pending : m_pending_instances) {
+            if (pending.step >= first_step) break;
+            try {
+                place_instance(pending);
+            } catch (const InputError&) {
+                first = std::current_exception(), first_step = pending.step;
+                break;
+            }
         }
-        if (m_error) std::rethrow_exception(m_error);
+        if (first) std::rethrow_exception(first);
+
+        std::vector<uint32_t> final_index(m_uses.size());
+        for (size_t i = 0; i < m_uses.size(); ++i) final_index[i] = m_named_index.at(m_uses[i].name);
         const uint32_t own_base = static_cast<uint32_t>(m_scene.materials.size());
         for (size_t i = 0; i < m_own.size(); ++i) {
             m_scene.materials.push_back(m_own[i]);
             m_scene.material_names.push_back(std::move(m_own_names[i]));
         }
         const auto renumber = [&](uint32_t& material) {
+            if (material == Instance::no_material) return;  // left to the instance
             material = material & provisional_own ? own_base + (material & ~provisional_own) : final_index[material];
+        };
+        const auto renumber_mesh = [&](TriangleMesh& mesh) {
+            // With MTL materials per triangle, `material` is unused (left 0, never provisional).
+            if (mesh.triangle_materials.empty()) renumber(mesh.material);
+            for (uint32_t& material : mesh.triangle_materials) renumber(material);
         };
         for (Sphere& sphere : m_scene.spheres) renumber(sphere.material);
         for (Box& box : m_scene.boxes) renumber(box.material);
         for (Plane& plane : m_scene.planes) renumber(plane.material);
-        for (TriangleMesh& mesh : m_scene.meshes) {
-            // With MTL materials per triangle, `material` is unused (left 0, never provisional).
-            if (mesh.triangle_materials.empty()) renumber(mesh.material);
-            for (uint32_t& material : mesh.triangle_materials) renumber(material);
-        }
+        for (TriangleMesh& mesh : m_scene.meshes) renumber_mesh(mesh);
+        for (Prototype& prototype : m_scene.prototypes)
+            for (TriangleMesh& mesh : prototype.meshes) renumber_mesh(mesh);
+        for (Instance& instance : m_scene.instances) renumber(instance.material);
     }
 
 private:
+    /// Every prototype, in file order. Only meshes and triangles, in groups or not, may be in one:
+    /// instances share triangles through Embree's instancing; analytic shapes and planes are not
+    /// instanced (and instances inside prototypes are not nested).
+    void add_prototypes(const std::vector<PrototypeDescription>& prototypes) {
+        for (const PrototypeDescription& d : prototypes) {
+            m_prototype_index[d.name] = static_cast<uint32_t>(m_scene.prototypes.size());
+            m_prototype_names.push_back(d.name);
+            Prototype prototype;
+            prototype.name = d.name;
+            m_prototype = &prototype;
+            add_object(d.object, Transform());
+            m_prototype = nullptr;
+            if (prototype.meshes.empty())
+                fail(d.where, "prototypes." + printable(d.name) + ": the prototype holds no triangles");
+            constexpr double inf = std::numeric_limits<double>::infinity();
+            prototype.lo = Vec3(inf), prototype.hi = Vec3(-inf);
+            for (const TriangleMesh& mesh : prototype.meshes)
+                for (size_t i = 0; i < mesh.vertex_count(); ++i) {
+                    const Vec3 p{mesh.positions[4 * i], mesh.positions[4 * i + 1], mesh.positions[4 * i + 2]};
+                    prototype.lo = min(prototype.lo, p), prototype.hi = max(prototype.hi, p);
+                }
+            m_scene.prototypes.push_back(std::move(prototype));
+        }
+    }
+
     static constexpr uint32_t provisional_own = 0x80000000u;
 
     /// A material name as first used, and where: the place an unknown name is reported.
@@ -129,6 +177,23 @@ private:
         std::string name;
         SourceLocation where;
         std::string kind;
+        uint64_t step = 0;
+    };
+
+    [[noreturn]] static void fail_unknown_material(const NameUse& use, const std::vector<std::string>& names) {
+        std::string known;
+        for (const auto& name : names) known += (known.empty() ? "" : ", ") + name;
+        fail(use.where, use.kind + ": unknown material '" + printable(use.name) + "'" + did_you_mean(use.name, names) +
+                            (known.empty() ? "; the scene defines no materials" : "; defined: " + known));
+    }
+
+    /// An instance met among the objects: its prototype is looked up once all are known.
+    struct PendingInstance {
+        Located<std::string> prototype;
+        SourceLocation where;
+        Transform to_world;
+        uint32_t material = Instance::no_material;
+        uint32_t object = 0;
         uint64_t step = 0;
     };
 
@@ -141,12 +206,17 @@ private:
     uint32_t resolve_material(const ObjectDescription& object) {
         ++m_step;
         const char* kind = to_string(object.type);
+        // In a prototype the material may be left to each instance.
+        if (!object.material && m_prototype) return Instance::no_material;
         if (!object.material) fail(object.where, std::string(kind) + ": missing required key 'material'");
         const MaterialReference& reference = *object.material;
         if (reference.inline_)
             return add_own_material(make_material(*reference.inline_, std::string(kind) + ".material"), "");
         // Most scenes name a handful of materials; the last one used is usually used again.
         if (m_last_use < m_uses.size() && m_uses[m_last_use].name == reference.name) return m_last_use;
+        // Once the named materials are known (the prototypes, built last), a name is checked here.
+        if (m_names_known && !m_named_index.count(reference.name))
+            fail_unknown_material({reference.name, reference.where, kind, m_step}, *m_names_known);
         const auto [it, added] = m_use_index.try_emplace(reference.name, static_cast<uint32_t>(m_uses.size()));
         if (added) m_uses.push_back({reference.name, reference.where, kind, m_step});
         return m_last_use = it->second;
@@ -159,7 +229,16 @@ private:
         if (!(std::fabs(to_world.determinant()) > 1e-300))
             fail(object.transform.empty() ? object.where : object.transform.front().where,
                  "the transform is singular (it flattens the object)");
+        if (m_prototype && object.type != ObjectType::mesh && object.type != ObjectType::triangle &&
+            object.type != ObjectType::group)
+            fail(object.where,
+                 std::string("prototypes.") + printable(m_prototype->name) +
+                     (object.type == ObjectType::instance ? ": an " : ": a ") + to_string(object.type) +
+                     " cannot be in a prototype; prototypes hold meshes and triangles (in groups or not)");
         switch (object.type) {
+            case ObjectType::instance:
+                add_instance(object, to_world);
+                break;
             case ObjectType::sphere: {
                 if (!(object.radius.value > 0)) fail(object.radius.where, "sphere.radius must be > 0");
                 m_scene.spheres.push_back({shared(to_world), object.center.value, object.radius.value,
@@ -200,6 +279,57 @@ private:
                 for (const auto& child : object.children) add_object(child, to_world);
                 break;
         }
+    }
+
+    /// The instance's material now (a provisional number, as every object's), its prototype in
+    /// finish(): the prototypes may come after the objects in the file.
+    void add_instance(const ObjectDescription& object, const Transform& to_world) {
+        PendingInstance pending;
+        pending.prototype = object.prototype;
+        pending.where = object.where;
+        pending.to_world = to_world;
+        pending.step = m_step;
+        if (object.material) pending.material = resolve_material(object);
+        pending.object = add_id(object);
+        m_pending_instances.push_back(std::move(pending));
+    }
+
+    void place_instance(const PendingInstance& pending) {
+        const auto it = m_prototype_index.find(pending.prototype.value);
+        if (it == m_prototype_index.end())
+            fail(pending.prototype.where,
+                 "instance: unknown prototype '" + printable(pending.prototype.value) + "'" +
+                     did_you_mean(pending.prototype.value, m_prototype_names) +
+                     (m_prototype_names.empty() ? "; the scene defines no prototypes"
+                                                : "; defined: " + join_names(m_prototype_names)));
+        const Prototype& prototype = m_scene.prototypes[it->second];
+        Instance instance;
+        instance.object_to_world = pending.to_world;
+        instance.prototype = it->second;
+        instance.material = pending.material;
+        if (pending.material == Instance::no_material) {
+            for (const TriangleMesh& mesh : prototype.meshes)
+                if (mesh.triangle_materials.empty() && mesh.material == Instance::no_material)
+                    fail(pending.where, "instance: prototype '" + printable(prototype.name) +
+                                            "' has triangles without a material; give the instance a 'material'");
+        }
+        // Embree holds the transform and the prototype's bounds in float.
+        for (int corner = 0; corner < 8; ++corner) {
+            const Vec3 p = pending.to_world.apply_point({corner & 1 ? prototype.hi.x : prototype.lo.x,
+                                                         corner & 2 ? prototype.hi.y : prototype.lo.y,
+                                                         corner & 4 ? prototype.hi.z : prototype.lo.z});
+            if (!(std::isfinite(float(p.x)) && std::isfinite(float(p.y)) && std::isfinite(float(p.z))))
+                fail(pending.where, "instance: prototype '" + printable(prototype.name) +
+                                        "' placed here reaches beyond float range (about 3.4e38)");
+        }
+        instance.object = pending.object;
+        m_scene.instances.push_back(instance);
+    }
+
+    static std::string join_names(const std::vector<std::string>& names) {
+        std::string out;
+        for (const auto& name : names) out += (out.empty() ? "" : ", ") + printable(name);
+        return out;
     }
 
     void add_inline_mesh(const ObjectDescription& object, const Transform& to_world) {
@@ -292,11 +422,13 @@ private:
             if (!std::isfinite(mesh.positions[i]))
                 fail(where, "vertex " + std::to_string(i / 4) +
                                 " is beyond float range (about 3.4e38) once transformed to world space");
-        m_scene.meshes.push_back(std::move(mesh));
+        (m_prototype ? m_prototype->meshes : m_scene.meshes).push_back(std::move(mesh));
     }
 
-    /// The object's number (1-based, file order): see SceneObject.
+    /// The object's number (1-based, file order): see SceneObject. Inside a prototype none: the
+    /// instance is the object.
     uint32_t add_id(const ObjectDescription& object) {
+        if (m_prototype) return 0;
         m_scene.objects.push_back({object.type, object.where});
         return static_cast<uint32_t>(m_scene.objects.size());
     }
@@ -346,11 +478,17 @@ private:
     std::vector<NameUse> m_uses;  ///< material names in order of first use
     std::unordered_map<std::string, uint32_t> m_use_index;
     uint32_t m_last_use = UINT32_MAX;
+    std::unordered_map<std::string_view, uint32_t> m_named_index;  ///< finish(): the named materials
+    const std::vector<std::string>* m_names_known = nullptr;        ///< set once they are known
     std::vector<Material> m_own;  ///< inline and MTL materials, as met
     std::vector<std::string> m_own_names;
     uint64_t m_step = 0;  ///< objects and material references seen: orders mistakes as met
     std::exception_ptr m_error;
     uint64_t m_error_step = 0;
+    std::vector<PendingInstance> m_pending_instances;
+    std::unordered_map<std::string, uint32_t> m_prototype_index;
+    std::vector<std::string> m_prototype_names;
+    Prototype* m_prototype = nullptr;  ///< the prototype being built, or null: the scene's own objects
 };
 
 }  // namespace
@@ -358,6 +496,16 @@ private:
 size_t Scene::triangle_count() const {
     size_t n = 0;
     for (const auto& mesh : meshes) n += mesh.triangle_count();
+    for (const auto& prototype : prototypes)
+        for (const auto& mesh : prototype.meshes) n += mesh.triangle_count();
+    return n;
+}
+
+size_t Scene::instanced_triangle_count() const {
+    size_t n = 0;
+    for (const auto& mesh : meshes) n += mesh.triangle_count();
+    for (const auto& instance : instances)
+        for (const auto& mesh : prototypes[instance.prototype].meshes) n += mesh.triangle_count();
     return n;
 }
 
@@ -523,7 +671,7 @@ Scene validate_scene(const SceneDescription& d) {
     SceneBuilder builder(scene);
     for (const ObjectDescription& object : d.objects) builder.add_top_level(object);
     validate_settings(d, scene);
-    builder.finish(d.materials);
+    builder.finish(d);
     check_triangle_limit(scene);
     return scene;
 }
@@ -546,7 +694,7 @@ Scene load_scene(const Parse& parse, SceneDescription* settings) {
     };
     SceneDescription d = parse(&sink);
     validate_settings(d, scene);
-    builder->finish(d.materials);
+    builder->finish(d);
     check_triangle_limit(scene);
     if (settings) *settings = std::move(d);
     return scene;
