@@ -25,7 +25,10 @@ echo "== find_package(Whitted 0.2) build"
 cmake -S "$source/examples/library" -B "$work/consumer" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" \
   -DCMAKE_BUILD_TYPE=Release >"$work/consumer.configure.log" || { cat "$work/consumer.configure.log"; exit 1; }
 cmake --build "$work/consumer" >"$work/consumer.build.log" || { cat "$work/consumer.build.log"; exit 1; }
-"$work/consumer/one_sphere" "$work/consumer.exr"
+# $WHITTED_TEST_PRELOAD: the ASan runtime in a sanitizer build (CMakeLists.txt), for the
+# uninstrumented programs that load our instrumented library; empty otherwise.
+with_runtime() { LD_PRELOAD="${WHITTED_TEST_PRELOAD:-${LD_PRELOAD:-}}" "$@"; }
+with_runtime "$work/consumer/one_sphere" "$work/consumer.exr"
 
 echo "== a version the package does not promise is refused: find_package(Whitted 0.3)"
 mkdir -p "$work/wrong_version"
@@ -45,7 +48,7 @@ export PKG_CONFIG_PATH="$prefix/lib/pkgconfig"
 # shellcheck disable=SC2046
 c++ -O2 -o "$work/one_sphere_pc" "$source/examples/library/one_sphere.cpp" $(pkg-config --cflags --libs whitted) \
   -Wl,-rpath,"$prefix/lib"
-"$work/one_sphere_pc"
+with_runtime "$work/one_sphere_pc"
 
 echo "== the installed program and the plug-in beside the library"
 # Not the build tree's plug-in: the installed one, found from PREFIX/bin/whitted.
@@ -55,7 +58,7 @@ python=${WHITTED_TEST_PYTHON:-/usr/bin/python3}
 if [ "$python_module" = OFF ]; then
   echo "(built with -DWHITTED_BUILD_PYTHON=OFF: no Python module to check)"
 elif [ -x "$python" ] && [ -d "$prefix/lib/python3/dist-packages" ]; then
-  PYTHONPATH="$prefix/lib/python3/dist-packages" "$python" - "$prefix" "$work/consumer.exr" <<'PY'
+  PYTHONPATH="$prefix/lib/python3/dist-packages" with_runtime "$python" - "$prefix" "$work/consumer.exr" <<'PY'
 import sys
 import numpy as np
 import whitted
