@@ -13,7 +13,12 @@ want="libwhitted.so.$(echo "$version" | cut -d. -f1,2)"
 symbols=$(nm -DC --defined-only "$lib" | cut -d' ' -f3-)
 count=$(printf '%s\n' "$symbols" | grep -c . || true)
 [ "$count" -gt 10 ] || { echo "FAIL: only $count symbols exported"; exit 1; }
-others=$(printf '%s\n' "$symbols" | grep -v 'whitted::api::' || true)
+# Inline entities of the standard library itself (typeinfo of libstdc++'s internal bases, a
+# static table in an inline function) may be exported too: libstdc++ declares namespace std with
+# default visibility, and without link-time optimisation (the sanitizer build) they are kept as
+# weak, merged definitions. They are the standard library's, not ours, so they are let through.
+others=$(printf '%s\n' "$symbols" | grep -v 'whitted::api::' |
+  grep -Ev '^((typeinfo|typeinfo name|vtable) for )?std::' || true)
 if [ -n "$others" ]; then
   echo "FAIL: symbols outside whitted::api:"; printf '%s\n' "$others" | head -20; exit 1
 fi

@@ -137,7 +137,10 @@ def test_sigint_stops_a_render_within_a_second(tmp_path):
             sys.exit(42)
         print("finished", flush=True)
     """)
-    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    env = dict(os.environ)
+    if os.environ.get("WHITTED_TEST_PYTHON_PRELOAD"):  # the sanitizer build (conftest.py)
+        env["LD_PRELOAD"] = os.environ["WHITTED_TEST_PYTHON_PRELOAD"]
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=env)
     assert proc.stdout.readline().strip() == "rendering"
     time.sleep(0.5)  # well inside the render
     sent = time.monotonic()
