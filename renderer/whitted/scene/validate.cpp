@@ -61,8 +61,11 @@ Material make_material(const MaterialDescription& d, const std::string& what) {
 /// material numbers (a name's number in order of first use, or an inline/MTL material's number
 /// with `provisional_own` set); finish() validates the named materials, places them first (named
 /// in file order, then inline and MTL ones as met, as Scene::materials says) and renumbers.
+/// Instances get their prototype in finish() too, since `prototypes` may also come later.
 /// Mistakes are reported in the order validate_scene always used: the named materials first, then
-/// the objects in file order, each object's own checks in the order add_object makes them.
+/// the prototypes, then the objects in file order, each object's own checks in the order
+/// add_object makes them. The name tables finish() sets up point into its argument: they serve
+/// only while it runs.
 class SceneBuilder {
 public:
     explicit SceneBuilder(Scene& scene) : m_scene(scene) {}
