@@ -405,8 +405,9 @@ Expected<void> write_image(const Image& image, const std::string& path, const Wr
 }
 
 Expected<std::string> to_povray(const Scene& scene) {
-    return guarded<std::string>("converting " + scene.path(),
-                                [&]() -> Expected<std::string> { return pov::scene_to_sdl(scene.impl().converter_description()); });
+    return guarded<std::string>("converting " + scene.path(), [&]() -> Expected<std::string> {
+        return pov::scene_to_sdl(scene.impl().converter_description());
+    });
 }
 
 Expected<std::string> write_povray(const Scene& scene, const std::string& pov_path) {

@@ -482,8 +482,8 @@ private:
     std::unordered_map<std::string, uint32_t> m_use_index;
     uint32_t m_last_use = UINT32_MAX;
     std::unordered_map<std::string_view, uint32_t> m_named_index;  ///< finish(): the named materials
-    const std::vector<std::string>* m_names_known = nullptr;        ///< set once they are known
-    std::vector<Material> m_own;  ///< inline and MTL materials, as met
+    const std::vector<std::string>* m_names_known = nullptr;       ///< set once they are known
+    std::vector<Material> m_own;                                   ///< inline and MTL materials, as met
     std::vector<std::string> m_own_names;
     uint64_t m_step = 0;  ///< objects and material references seen: orders mistakes as met
     std::exception_ptr m_error;
