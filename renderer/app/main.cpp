@@ -182,6 +182,24 @@ private:
     std::chrono::steady_clock::time_point m_start = std::chrono::steady_clock::now(), m_last = m_start;
 };
 
+/// Runs `work`; a mistake in the input it throws is printed as `whitted` prints it, and the exit
+/// status returned (−1: none). `scene` names the file for errors that do not carry a place (a
+/// filesystem error, say).
+template <class Work>
+int exit_on_input_error(const std::string& scene, Work&& work) {
+    try {
+        work();
+        return -1;
+    } catch (const InputError& e) {
+        print_error(e.what());
+    } catch (const std::invalid_argument& e) {
+        print_error(e.what());
+    } catch (const std::exception& e) {
+        print_error(scene + ": " + e.what());
+    }
+    return exit_bad_input;
+}
+
 /// The API's error, printed as `whitted` always has; its exit status.
 int report(const api::Error& error) {
     print_error(error.what());
@@ -205,8 +223,8 @@ int run_render(const RenderArguments& args) {
     OutputOptions output = output_options(args);
     LayerSet layers;
     std::optional<api::Scene> loaded;
-    try {
-        // Usage first, in milliseconds: nothing here reads the scene.
+    // Usage first, in milliseconds: nothing here reads the scene.
+    const auto check_usage = [&] {
         check_output_path(args.output);
         if (!args.layers.empty()) {
             layers = parse_layers(args.layers);
@@ -214,16 +232,8 @@ int run_render(const RenderArguments& args) {
         }
         check_output_options(args.output, output);
         refuse_output_over(args.output, args.scene, "scene file");
-    } catch (const InputError& e) {
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::invalid_argument& e) {
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::exception& e) {  // e.g. a filesystem error
-        print_error(args.scene + ": " + e.what());
-        return exit_bad_input;
-    }
+    };
+    if (const int status = exit_on_input_error(args.scene, check_usage); status >= 0) return status;
     api::Expected<api::Scene> read = api::load_scene_file(args.scene);
     if (!read) return report(read.error());
     loaded.emplace(std::move(read).value());
@@ -231,7 +241,8 @@ int run_render(const RenderArguments& args) {
     const SceneDescription& description = impl.description;
     const Scene& scene = impl.scene;
     timer.lap();
-    try {
+    // What the scene asks that the output must allow.
+    const auto check_scene_output = [&] {
         if (args.layers.empty() && !description.layers.empty()) {
             // The scene's render.layers, unless --layers was given (--layers none turns them off).
             layers = parse_layers(loaded->layers());  // validated with the scene: the names are known
@@ -248,16 +259,8 @@ int run_render(const RenderArguments& args) {
                 if (material.fresnel_r0 >= 0)
                     throw std::invalid_argument(
                         "render layers are not available for scenes with a fresnel_ior (glazed) material yet");
-    } catch (const InputError& e) {
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::invalid_argument& e) {
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::exception& e) {
-        print_error(args.scene + ": " + e.what());
-        return exit_bad_input;
-    }
+    };
+    if (const int status = exit_on_input_error(args.scene, check_scene_output); status >= 0) return status;
 
     try {
         const Accelerator& accelerator = impl.accelerator(args.threads);  // api::render uses this one
@@ -324,7 +327,8 @@ int run_render(const RenderArguments& args) {
         if (args.stats)
             std::fprintf(
                 stderr,
-                "whitted: stages: read (parse, validate, load meshes) %.3fs, build BVH %.3fs, render %.3fs, write %.3fs; "
+                "whitted: stages: read (parse, validate, load meshes) %.3fs, build BVH %.3fs, render %.3fs, write "
+                "%.3fs; "
                 "%zu triangles, %zu spheres, %zu boxes, %zu planes, %zu lights, %zu instances (%zu triangles seen); "
                 "BVH %.1f MB (%.1f MB while building); Embree %s, %d-wide packets\n",
                 impl.read_seconds, build_seconds, result.stats.seconds, write_seconds, scene.triangle_count(),
