@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
 // Fuzzes the POV-Ray writer: any scene that Whitted accepts is converted, and the SDL must
 // consist only of what the writer itself emits: its keywords, punctuation, finite numbers,
-// and `//` comments (holding no line break). A name, a string or a directive smuggled in
-// from the scene file, or an `inf`/`nan` that POV-Ray would misparse, is a finding.
+// `//` comments (holding no line break), and the names it gives prototype meshes
+// (`#declare whitted_prototype_I_K =`, used only after they are declared). A name, a string
+// or a directive smuggled in from the scene file, or an `inf`/`nan` that POV-Ray would
+// misparse, is a finding.
 
 #include "converters/pov_writer.h"
 #include "fuzz_support.h"
@@ -13,6 +15,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <regex>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -20,22 +23,60 @@
 namespace {
 
 const std::set<std::string>& sdl_keywords() {
-    static const std::set<std::string> words{"adc_bailout",  "ambient",        "ambient_light",
-                                             "angle",        "assumed_gamma",  "background",
-                                             "box",          "brilliance",     "camera",
-                                             "color",        "diffuse",        "face_indices",
-                                             "finish",       "global_lights",  "global_settings",
-                                             "light_group",  "light_source",   "location",
-                                             "look_at",      "matrix",         "max_trace_level",
-                                             "mesh2",        "normal_vectors", "off",
-                                             "orthographic", "parallel",       "perspective",
-                                             "phong",        "phong_size",     "pigment",
-                                             "plane",        "point_at",       "reflection",
-                                             "rgb",          "rgbf",           "rgbt",
-                                             "right",        "roughness",      "sky",
-                                             "specular",     "sphere",         "texture",
-                                             "up",           "vertex_vectors"};
+    static const std::set<std::string> words{"adc_bailout",
+                                             "ambient",
+                                             "ambient_light",
+                                             "angle",
+                                             "assumed_gamma",
+                                             "background",
+                                             "box",
+                                             "brilliance",
+                                             "camera",
+                                             "color",
+                                             "diffuse",
+                                             "face_indices",
+                                             "finish",
+                                             "global_lights",
+                                             "global_settings",
+                                             "light_group",
+                                             "light_source",
+                                             "location",
+                                             "look_at",
+                                             "matrix",
+                                             "max_trace_level",
+                                             "mesh2",
+                                             "normal_vectors",
+                                             "object",
+                                             "off",
+                                             "orthographic",
+                                             "parallel",
+                                             "perspective",
+                                             "phong",
+                                             "phong_size",
+                                             "pigment",
+                                             "plane",
+                                             "point_at",
+                                             "reflection",
+                                             "rgb",
+                                             "rgbf",
+                                             "rgbt",
+                                             "right",
+                                             "roughness",
+                                             "sky",
+                                             "specular",
+                                             "sphere",
+                                             "texture",
+                                             "translate",
+                                             "union",
+                                             "up",
+                                             "vertex_vectors"};
     return words;
+}
+
+/// `whitted_prototype_<digits>_<digits>`: the only names the writer makes up.
+bool is_prototype_name(const std::string& word) {
+    static const std::regex name("whitted_prototype_[0-9]+_[0-9]+");
+    return std::regex_match(word, name);
 }
 
 [[noreturn]] void reject(const std::string& sdl, size_t at, const char* why) {
@@ -49,6 +90,7 @@ void check_sdl(const std::string& sdl) {
     size_t i = 0;
     const size_t n = sdl.size();
     bool seen_version = false;
+    std::set<std::string> declared;
     while (i < n) {
         const unsigned char c = sdl[i];
         if (c == ' ' || c == '\n') {
@@ -61,13 +103,26 @@ void check_sdl(const std::string& sdl) {
                     reject(sdl, k, "control character in a comment");
             i = end + 1;
         } else if (c == '#') {
-            if (seen_version || sdl.compare(i, 14, "#version 3.7;\n") != 0) reject(sdl, i, "directive");
-            seen_version = true;
-            i += 14;
+            if (!seen_version) {
+                if (sdl.compare(i, 14, "#version 3.7;\n") != 0) reject(sdl, i, "directive");
+                seen_version = true;
+                i += 14;
+                continue;
+            }
+            // `#declare NAME =\n`, each name once.
+            static const std::string declare = "#declare ";
+            if (sdl.compare(i, declare.size(), declare) != 0) reject(sdl, i, "directive");
+            const size_t name_start = i + declare.size();
+            const size_t name_end = sdl.find(" =\n", name_start);
+            if (name_end == std::string::npos) reject(sdl, i, "unterminated #declare");
+            const std::string name = sdl.substr(name_start, name_end - name_start);
+            if (!is_prototype_name(name) || !declared.insert(name).second) reject(sdl, i, "#declare of a name");
+            i = name_end + 3;
         } else if (std::isalpha(c) || c == '_') {
             size_t end = i;
             while (end < n && (std::isalnum(static_cast<unsigned char>(sdl[end])) || sdl[end] == '_')) ++end;
-            if (!sdl_keywords().count(sdl.substr(i, end - i))) reject(sdl, i, "unexpected identifier");
+            const std::string word = sdl.substr(i, end - i);
+            if (!sdl_keywords().count(word) && !declared.count(word)) reject(sdl, i, "unexpected identifier");
             i = end;
         } else if (std::isdigit(c) || c == '-' || c == '.') {
             // A number as fmt writes a double: -?digits[.digits][e[+-]digits]
