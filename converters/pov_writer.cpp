@@ -298,6 +298,14 @@ private:
         for (const auto& t : triangles)
             o += ",\n    <" + std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " + std::to_string(t[2]) + ">";
         o += " }\n";
+        // Any inside_vector makes POV-Ray's mesh2 report every crossing of a ray, not only its
+        // nearest: without one, Mesh::intersect_bbox_tree stops at the first triangle hit, so a
+        // crossing the shadow test then throws away (t <= 1e-3) hid a farther one that blocks
+        // the light, and one below 1e-4 hid the next for camera and mirror rays. Whitted takes
+        // the nearest crossing inside each ray's window; with every crossing reported, POV-Ray's
+        // windows pick the same one (docs/pov-model.md §3). The vector itself only serves
+        // POV-Ray's inside test, which nothing here uses.
+        o += "  inside_vector <0, 0, 1>\n";
         if (!m_collect) o += "  " + texture(*material) + "\n";  // validate_scene checked it is there
         if (!(centre == Vec3(0.0))) o += "  translate " + vec(centre) + "\n";
         o += "}\n";

@@ -38,6 +38,7 @@ const std::set<std::string>& sdl_keywords() {
                                              "finish",
                                              "global_lights",
                                              "global_settings",
+                                             "inside_vector",
                                              "light_group",
                                              "light_source",
                                              "location",

@@ -119,6 +119,26 @@ TEST(PovWriter, FarMeshWrittenAboutItsOwnCentreWithTheSameFloatVertices) {
               (std::vector<double>{float(0.3), float(0.7), float(-0.1)}));
 }
 
+// Every mesh2 carries an inside_vector: only then does POV-Ray's mesh report all of a ray's
+// crossings instead of stopping at the nearest, so a shadow ray that meets the mesh within 1e-3
+// of its start still sees the mesh farther on (docs/pov-model.md §3). That holds for a plain
+// mesh, an OBJ-free triangle, and a prototype's declared mesh alike.
+TEST(PovWriter, EveryMesh2HasAnInsideVector) {
+    const std::string sdl = sdl_for(
+        "prototypes:\n  tri: {type: mesh, vertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]], triangles: [[0, 1, 2]]}\n"
+        "objects:\n  - {type: mesh, material: {kd: 0.5}, triangles: [[0, 1, 2]], "
+        "vertices: [[0.3, 0.7, -0.1], [1.9, 0.2, 0.5], [-0.9, 2.6, -0.9]]}\n"
+        "  - {type: triangle, material: {kd: 0.5}, vertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]]}\n"
+        "  - {type: instance, prototype: tri, material: {kd: 0.5}}\n");
+    ASSERT_EQ(count_of(sdl, "mesh2 {"), 3u);
+    EXPECT_EQ(count_of(sdl, "inside_vector <0, 0, 1>"), 3u);
+    for (size_t at = sdl.find("mesh2 {"); at != std::string::npos; at = sdl.find("mesh2 {", at + 1)) {
+        const size_t faces = sdl.find("face_indices", at);
+        EXPECT_LT(faces, sdl.find("inside_vector", at));  // inside this mesh2, after its faces
+        EXPECT_LT(sdl.find("inside_vector", at), sdl.find("}\n}", faces) + 3);
+    }
+}
+
 // Awkward doubles (0.1 + 0.2, tiny, huge, many digits) come back bit for bit.
 TEST(PovWriter, NumbersRoundTripExactly) {
     const std::string text =
