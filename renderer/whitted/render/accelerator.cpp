@@ -438,6 +438,7 @@ struct Accelerator::Impl {
         rtc_scene = rtcNewScene(device);
         quality = build_quality();
         rtcSetSceneBuildQuality(rtc_scene, quality);
+        rtcSetSceneFlags(rtc_scene, RTC_SCENE_FLAG_ROBUST);
         frame = choose_frame();
         spheres.offset = boxes.offset = frame.offset;
         for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
@@ -588,6 +589,7 @@ struct Accelerator::Impl {
             RTCScene prototype_scene = rtcNewScene(device);
             prototype_scenes.push_back(prototype_scene);
             rtcSetSceneBuildQuality(prototype_scene, quality);
+            rtcSetSceneFlags(prototype_scene, RTC_SCENE_FLAG_ROBUST);
             for (const TriangleMesh& mesh : prototype.meshes)
                 add_mesh(prototype_scene, mesh, Vec3(0.0), &instance_transforms);
             rtcCommitScene(prototype_scene);
