@@ -23,12 +23,14 @@
 #include <CLI/CLI.hpp>
 
 #include <sys/prctl.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -50,6 +52,18 @@ std::atomic<int> g_signal{0};
 std::atomic<bool> g_exit_on_signal{true};
 /// Under mpirun or srun: this process is one rank of a distributed render (docs/distributed.md).
 std::unique_ptr<WorkExchange> g_exchange;
+/// CLOCK_MONOTONIC (ns) of the CancelWatchdog's latest 20 ms poll, 0 while no render runs: a
+/// SIGCONT arriving long after it means this process had been stopped (see on_continue).
+std::atomic<int64_t> g_watchdog_tick_ns{0};
+/// CLOCK_MONOTONIC (ns) at which the watchdog last found its own poll more than 100 ms late: after
+/// a stop the SIGCONT can reach a thread only after the watchdog woke and polled again.
+std::atomic<int64_t> g_watchdog_stall_ns{0};
+
+int64_t monotonic_ns() {
+    timespec now{};
+    ::clock_gettime(CLOCK_MONOTONIC, &now);  // async-signal-safe, unlike std::chrono's clocks
+    return int64_t{now.tv_sec} * 1'000'000'000 + now.tv_nsec;
+}
 
 extern "C" void on_signal(int signal) {
     if (g_exit_on_signal.load()) {
@@ -58,6 +72,23 @@ extern "C" void on_signal(int signal) {
         ::_exit(128 + signal);  // async-signal-safe; no temporary file exists yet
     }
     g_signal.store(signal);
+    g_cancel.store(true);
+}
+
+/// Open MPI 4.1's mpirun, on SIGINT or SIGTERM, sends the ranks SIGCONT at once and SIGTERM only
+/// odls_base_sigkill_timeout (1 s) later; it also forwards Ctrl-Z as SIGSTOP and `fg` as SIGCONT,
+/// both from its own pid (strace of the ranks, docs/distributed.md). So a SIGCONT from the
+/// parent while the watchdog polled a moment ago (the process was not stopped) is the start of
+/// mpirun ending the job: cancel as for SIGTERM. After a stop the last poll is old: a resume.
+extern "C" void on_continue(int, siginfo_t* info, void*) {
+    if (info->si_code != SI_USER || info->si_pid != ::getppid()) return;
+    const int64_t tick = g_watchdog_tick_ns.load();  // before the stall: the watchdog stores it first
+    const int64_t stall = g_watchdog_stall_ns.load();
+    const int64_t now = monotonic_ns();
+    // 150 ms: the watchdog polls every 20 ms; a late poll on a loaded machine only means the
+    // SIGTERM a second later does the job, never that a resumed render is cancelled.
+    if (tick == 0 || now - tick > 150'000'000 || now - stall < 1'000'000'000) return;
+    g_signal.store(SIGTERM);
     g_cancel.store(true);
 }
 
@@ -75,6 +106,7 @@ public:
         }
         m_wake.notify_one();  // at once: a sleeping watchdog cost every render up to 20 ms
         m_thread.join();
+        g_watchdog_tick_ns.store(0);  // no render to cancel any more (on_continue)
     }
     CancelWatchdog(const CancelWatchdog&) = delete;
     CancelWatchdog& operator=(const CancelWatchdog&) = delete;
@@ -88,7 +120,12 @@ private:
 
     void watch() {
         // A signal handler cannot wake a condition variable, so the signal flag is polled.
+        int64_t previous = monotonic_ns();
         while (!done_within(std::chrono::milliseconds(20))) {
+            const int64_t now = monotonic_ns();
+            if (now - previous > 100'000'000) g_watchdog_stall_ns.store(now);  // stopped, or starved
+            g_watchdog_tick_ns.store(now);
+            previous = now;
             if (!g_cancel.load()) continue;
             if (done_within(std::chrono::milliseconds(900))) return;
             // Under MPI rank 0 can also be waiting on a rank that died in the middle of a message.
@@ -113,6 +150,13 @@ void install_signal_handlers() {
     sigemptyset(&action.sa_mask);
     sigaction(SIGINT, &action, nullptr);
     sigaction(SIGTERM, &action, nullptr);
+    if (g_exchange) {  // only an MPI rank has an mpirun for a parent (on_continue)
+        struct sigaction on_cont {};
+        on_cont.sa_sigaction = on_continue;
+        on_cont.sa_flags = SA_SIGINFO | SA_RESTART;
+        sigemptyset(&on_cont.sa_mask);
+        sigaction(SIGCONT, &on_cont, nullptr);
+    }
 }
 
 void print_error(const std::string& message) {

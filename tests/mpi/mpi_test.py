@@ -10,16 +10,24 @@
   kill       WHITTED  kill -9 one rank (not rank 0) mid-render of a large image: mpirun exits
              non-zero and says a rank died, the previous output is byte for byte intact, no
              temporary file is left, no rank is left running.
-  signal     WHITTED  SIGTERM, then SIGINT, to mpirun mid-render: non-zero exit, previous output
-             intact, no temporary file, and every rank gone: within 1.5 s with Open MPI's defaults
-             (mpirun sends the ranks SIGCONT, waits odls_base_sigkill_timeout = 1 s, then SIGTERM,
-             which they obey at once, rank 0 saying so), and within 1 s with
-             --mca odls_base_sigkill_timeout 0 (SIGTERM at once, SIGKILL right after).
+  signal     WHITTED  SIGTERM and SIGINT to mpirun mid-render, five runs with Open MPI's defaults:
+             non-zero exit, previous output intact, no temporary file, every rank gone, the median
+             time from the signal to the last rank gone under 1 s (mpirun sends the ranks SIGCONT at
+             once and SIGTERM only a second later; a rank that was not stopped takes that SIGCONT
+             as the end of the job), no run over 2 s. Then job control: SIGTSTP to mpirun stops
+             every rank, SIGCONT resumes them, and the render finishes with the one-process pixels.
   sweep      WHITTED SOURCE_DIR  scripts/validate on five scenes of tests/pov and one broken scene,
              serially and as mpirun -np 3 scripts/validate --mpi: the same verdict lines, the same
              index rows, the same per-scene output (label pov too: it runs POV-Ray).
   startup    WHITTED  the program does not link libmpi and does not load it without MPI in the
              environment; under mpirun it loads it (LD_DEBUG=files).
+
+  hosts      WHITTED  two simulated hosts: network namespaces joined by a veth pair (10.77.0.1 and
+             .2), mpirun in the first, netns_agent.sh (ip netns exec) as its launcher instead of
+             ssh, Open MPI's TCP transport only (btl tcp,self, no shared memory): each rank in
+             its namespace (ip netns identify through the same launch), 2 hosts x 1 and x 2 ranks,
+             the one-process pixels. SKIPPED (exit 77) without ip or CAP_NET_ADMIN; the
+             namespaces are deleted however it ends.
 
 mpirun missing is a failure with the package to install, never a skip."""
 
@@ -230,37 +238,89 @@ def kill(whitted, directory):
 
 def signal_mode(whitted, directory):
     problems = []
-    no_grace = ("--mca", "odls_base_sigkill_timeout", "0")
-    said = 0  # default-grace runs in which rank 0's message came through
-    for sig, mca, limit in ((signal.SIGTERM, (), 1.5), (signal.SIGINT, (), 1.5), (signal.SIGTERM, no_grace, 1.0),
-                            (signal.SIGINT, no_grace, 1.0)):
-        process, pids, output, scene = start_big_render(whitted, directory, 2, mca)
+    said = 0  # runs in which rank 0's message came through
+    times = []
+    # Open MPI's defaults (no --mca): the ranks stop on mpirun's first SIGCONT, not its SIGTERM a
+    # second later. Five runs, the median asserted: one run on a loaded 2-core VM can be late.
+    for sig in (signal.SIGTERM, signal.SIGINT, signal.SIGTERM, signal.SIGINT, signal.SIGTERM):
+        process, pids, output, scene = start_big_render(whitted, directory, 2)
         process.send_signal(sig)
         sent = time.monotonic()
         deadline = sent + 10
         while time.monotonic() < deadline and (process.poll() is None or any(alive(p) for p in pids.values())):
             time.sleep(0.01)
         seconds = time.monotonic() - sent
+        times.append(seconds)
         text = process.communicate(timeout=10)[0] if process.poll() is not None else ""
-        name = signal.Signals(sig).name + (" " + " ".join(mca) if mca else "")
+        name = signal.Signals(sig).name
         print(f"{name} to mpirun: mpirun exit {process.returncode}, every rank gone after {seconds:.2f}s; "
               f"output:\n{text}")
-        if seconds > limit:
-            problems.append(f"{name}: the ranks took {seconds:.2f}s to end (more than {limit} s)")
-        if not mca and "interrupted; nothing written" in text:
+        if seconds > 2.0:
+            problems.append(f"{name}: the ranks took {seconds:.2f}s to end (more than 2 s even for one run)")
+        if "interrupted; nothing written" in text:
             said += 1
         if process.returncode == 0:
             problems.append(f"{name}: mpirun exited 0")
         check_outcome(directory, output, scene, pids, problems, name)
         os.remove(output)
-    # mpirun, shutting down, can drop a rank's last line of output, so one of the two runs must
-    # show that rank 0 stopped on the signal itself (not killed), not necessarily both.
+    median = sorted(times)[len(times) // 2]
+    print(f"signal to every rank gone: median {median:.2f}s of {', '.join(f'{t:.2f}' for t in times)}")
+    if median >= 1.0:
+        problems.append(f"median {median:.2f}s from the signal to every rank gone, not under 1 s")
+    # mpirun, shutting down, can drop a rank's last line of output, so some runs must show that
+    # rank 0 stopped on the signal itself (not killed), not necessarily all.
     if said == 0:
-        problems.append("in neither default run did rank 0 say it stopped without writing")
+        problems.append("in no run did rank 0 say it stopped without writing")
+    job_control(whitted, directory, problems)
     if problems:
         fail("\n  ".join(problems))
-    print("PASS: SIGTERM and SIGINT to mpirun end every rank (within 1 s with odls_base_sigkill_timeout 0, "
-          "1.5 s with mpirun's 1 s default grace), the previous output intact")
+    print("PASS: SIGTERM and SIGINT to mpirun end every rank in under 1 s (median) with Open MPI's defaults, "
+          "the previous output intact; a render stopped and resumed through mpirun finishes, identical")
+
+
+def job_control(whitted, directory, problems):
+    """Ctrl-Z / fg: mpirun forwards them to the ranks as SIGSTOP and SIGCONT, the same SIGCONT
+    it sends when ending the job; a resumed render must finish, with the same pixels."""
+    import numpy
+    scene = os.path.join(directory, "resumed.yaml")
+    with open(scene, "w") as f:
+        f.write(MIRRORS.format(w=1600, h=1200, s=2))
+    reference = os.path.join(directory, "resumed-one-process.exr")
+    env = mpi_env()
+    env["WHITTED_MPI"] = "0"
+    run = subprocess.run([whitted, "render", scene, "-o", reference, "-q"], env=env, capture_output=True, text=True)
+    if run.returncode != 0:
+        fail(f"one-process render for the job-control check: exit {run.returncode}: {run.stderr}")
+    output = os.path.join(directory, "resumed.exr")
+    started = time.monotonic()
+    process = subprocess.Popen(mpirun_prefix(2) + [whitted, "render", scene, "-o", output, "-t", "1", "-q"],
+                               env=mpi_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    pids = {}
+    while time.monotonic() < started + 30 and process.poll() is None and len(pids) < 2:
+        pids = rank_pids(output)
+        time.sleep(0.05)
+    time.sleep(1.0)  # into the render (loading takes milliseconds)
+    if process.poll() is not None or len(pids) < 2:
+        problems.append(f"job control: the render ended before it could be stopped: {process.communicate()[0]}")
+        return
+    process.send_signal(signal.SIGTSTP)
+    time.sleep(1.0)
+    states = {}
+    for rank, pid in pids.items():
+        with open(f"/proc/{pid}/stat") as f:
+            states[rank] = f.read().split(")")[-1].split()[0]
+    process.send_signal(signal.SIGCONT)
+    text = process.communicate(timeout=300)[0]
+    print(f"job control: rank states while stopped {states}; after SIGCONT mpirun exit {process.returncode} "
+          f"{time.monotonic() - started:.2f}s after the start; output:\n{text}")
+    if any(state != "T" for state in states.values()):
+        problems.append(f"job control: SIGTSTP to mpirun did not stop every rank: {states}")
+    if process.returncode != 0:
+        problems.append(f"job control: the resumed render failed (exit {process.returncode}): {text.strip()}")
+        return
+    got, expected = read_exr(output), read_exr(reference)
+    if got.shape != expected.shape or numpy.any(got != expected):
+        problems.append("job control: the resumed render differs from the one-process render")
 
 
 def startup(whitted, directory):
@@ -346,8 +406,88 @@ def sweep(whitted, directory, source_dir):
     print("PASS: the distributed sweep gives the serial run's verdicts and index rows")
 
 
+def hosts(whitted, directory):
+    """Two simulated hosts: network namespaces joined by a veth pair, Open MPI's TCP transport only,
+    launched through netns_agent.sh instead of ssh. Skips (exit 77) without ip or CAP_NET_ADMIN."""
+    import numpy
+    ip = shutil.which("ip")
+    if not ip:
+        print("SKIPPED: no `ip` command (apt-get install iproute2; scripts/setup --with-test-tools does)")
+        sys.exit(77)
+    # The namespaces outlive this process: a SIGTERM (ctest's timeout, Ctrl-C) must reach `finally`.
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+    tag = str(os.getpid())
+    ns = [f"whitted{tag}a", f"whitted{tag}b"]
+    veth = [f"wv{tag}a", f"wv{tag}b"]
+    addresses = ["10.77.0.1", "10.77.0.2"]
+
+    def ip_run(*args, check=True):
+        run = subprocess.run([ip, *args], capture_output=True, text=True)
+        if check and run.returncode != 0:
+            raise RuntimeError(f"ip {' '.join(args)}: {run.stderr.strip()}")
+        return run
+
+    try:
+        ip_run("netns", "add", ns[0])
+    except RuntimeError as e:
+        print(f"SKIPPED: cannot create a network namespace (needs CAP_NET_ADMIN): {e}")
+        sys.exit(77)
+    try:
+        ip_run("netns", "add", ns[1])
+        ip_run("link", "add", veth[0], "netns", ns[0], "type", "veth", "peer", "name", veth[1], "netns", ns[1])
+        for n, v, a in zip(ns, veth, addresses):
+            ip_run("-n", n, "addr", "add", a + "/24", "dev", v)
+            ip_run("-n", n, "link", "set", v, "up")
+            ip_run("-n", n, "link", "set", "lo", "up")
+        agent = os.path.join(os.path.dirname(os.path.abspath(__file__)), "netns_agent.sh")
+        env = mpi_env()
+        env["WHITTED_NETNS_MAP"] = " ".join(f"{a}={n}" for a, n in zip(addresses, ns))
+        problems = []
+        scene = os.path.join(directory, "hosts.yaml")
+        with open(scene, "w") as f:
+            f.write(MIRRORS.format(w=517, h=389, s=2))
+        reference = os.path.join(directory, "one-process.exr")
+        one = dict(env, WHITTED_MPI="0")
+        run = subprocess.run([whitted, "render", scene, "-o", reference, "-q"], env=one, capture_output=True, text=True)
+        if run.returncode != 0:
+            fail(f"one-process render: exit {run.returncode}: {run.stderr}")
+        expected = read_exr(reference)
+        for per_host in (1, 2):
+            ranks = 2 * per_host
+            mpirun = [ip, "netns", "exec", ns[0], shutil.which("mpirun") or "mpirun", "--oversubscribe",
+                      "-np", str(ranks), "--host", ",".join(f"{a}:{per_host}" for a in addresses),
+                      "--map-by", "node", "--mca", "plm_rsh_agent", agent, "--mca", "btl", "tcp,self",
+                      "--mca", "btl_tcp_if_include", "10.77.0.0/24", "--mca", "oob_tcp_if_include", "10.77.0.0/24"]
+            # Where each rank runs: the same launch, `ip netns identify` in place of whitted.
+            where = subprocess.run(mpirun + [ip, "netns", "identify"], env=env, capture_output=True, text=True,
+                                   timeout=120)
+            names = sorted(where.stdout.split())
+            print(f"{per_host} rank(s) per host: namespaces of the ranks {names} (exit {where.returncode})")
+            if where.returncode != 0 or names != sorted(ns * per_host):
+                problems.append(f"{per_host}/host: ranks not one set per namespace: {names}: {where.stderr[-1500:]}")
+                continue
+            output = os.path.join(directory, f"hosts-{per_host}.exr")
+            started = time.monotonic()
+            run = subprocess.run(mpirun + [whitted, "render", scene, "-o", output, "-t", "1"], env=env,
+                                 capture_output=True, text=True, timeout=300)
+            print(f"{per_host} rank(s) per host: exit {run.returncode} after {time.monotonic() - started:.2f}s: "
+                  f"{run.stderr.strip()[-1500:]}")
+            if run.returncode != 0 or f"rendered by {ranks} MPI rank(s)" not in run.stderr:
+                problems.append(f"{per_host}/host: the render failed or did not run on {ranks} ranks")
+                continue
+            got = read_exr(output)
+            if got.shape != expected.shape or numpy.any(got != expected):
+                problems.append(f"{per_host}/host: pixels differ from the one-process render")
+        if problems:
+            fail("\n  ".join(problems))
+        print("PASS: two simulated hosts (network namespaces, TCP only) give the one-process pixels")
+    finally:
+        for n in ns:  # deleting a namespace deletes its end of the veth pair, and so the pair
+            ip_run("netns", "del", n, check=False)
+
+
 def main():
-    modes = {"identical": identical, "kill": kill, "signal": signal_mode, "startup": startup, "sweep": sweep}
+    modes = {"identical": identical, "kill": kill, "signal": signal_mode, "startup": startup, "sweep": sweep, "hosts": hosts}
     if len(sys.argv) < 3 or sys.argv[1] not in modes:
         print(__doc__)
         sys.exit(2)
