@@ -438,6 +438,9 @@ struct Accelerator::Impl {
         rtc_scene = rtcNewScene(device);
         quality = build_quality();
         rtcSetSceneBuildQuality(rtc_scene, quality);
+        // Robust: Embree's watertight triangle test. Its fast one let a ray slip between two
+        // triangles of a closed mesh now and then and hit the inside (a black pixel in a lit
+        // torus); finish_hit can only refine the candidate Embree proposes, not find a missed one.
         rtcSetSceneFlags(rtc_scene, RTC_SCENE_FLAG_ROBUST);
         frame = choose_frame();
         spheres.offset = boxes.offset = frame.offset;
@@ -589,7 +592,7 @@ struct Accelerator::Impl {
             RTCScene prototype_scene = rtcNewScene(device);
             prototype_scenes.push_back(prototype_scene);
             rtcSetSceneBuildQuality(prototype_scene, quality);
-            rtcSetSceneFlags(prototype_scene, RTC_SCENE_FLAG_ROBUST);
+            rtcSetSceneFlags(prototype_scene, RTC_SCENE_FLAG_ROBUST);  // watertight, as the world's
             for (const TriangleMesh& mesh : prototype.meshes)
                 add_mesh(prototype_scene, mesh, Vec3(0.0), &instance_transforms);
             rtcCommitScene(prototype_scene);
