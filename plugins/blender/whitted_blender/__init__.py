@@ -1,0 +1,206 @@
+"""Whitted as a Blender render engine (docs/blender.md)."""
+bl_info = {
+    "name": "Whitted renderer",
+    "author": "Whitted",
+    "version": (0, 2, 0),
+    "blender": (3, 4, 0),
+    "location": "Render Properties > Render Engine > Whitted",
+    "description": "Renders with the lecture's Whitted model; checks against POV-Ray",
+    "category": "Render",
+}
+
+import os
+import sys
+import tempfile
+
+import bpy
+import numpy as np
+
+from .mapping import MappingError, dumps
+
+
+def _whitted():
+    """Import the `whitted` module; WHITTED_PYTHONPATH is searched first (why: build trees)."""
+    extra = os.environ.get("WHITTED_PYTHONPATH")
+    if extra:
+        for p in reversed(extra.split(os.pathsep)):
+            if p and p not in sys.path:
+                sys.path.insert(0, p)
+    import whitted
+    return whitted
+
+
+def scene_text(depsgraph):
+    from .export import describe
+    return dumps(describe(depsgraph))
+
+
+class WhittedSceneProps(bpy.types.PropertyGroup):
+    samples: bpy.props.IntProperty(name="Samples", default=1, min=1, max=64)
+    max_depth: bpy.props.IntProperty(name="Max depth", default=5, min=1, max=256)
+    ambient: bpy.props.FloatVectorProperty(name="Ambient Ia", subtype='COLOR', default=(0.1, 0.1, 0.1), min=0)
+    threads: bpy.props.IntProperty(name="Threads", default=0, min=0)
+
+
+class WhittedMaterialProps(bpy.types.PropertyGroup):
+    use_whitted: bpy.props.BoolProperty(name="Use these", default=False)
+    ka: bpy.props.FloatVectorProperty(name="ka", subtype='COLOR', default=(0.05, 0.05, 0.05), min=0)
+    kd: bpy.props.FloatVectorProperty(name="kd", subtype='COLOR', default=(0.5, 0.5, 0.5), min=0)
+    ks: bpy.props.FloatVectorProperty(name="ks", subtype='COLOR', default=(0.3, 0.3, 0.3), min=0)
+    p: bpy.props.FloatProperty(name="p", default=50.0, min=1e-3)
+    km: bpy.props.FloatVectorProperty(name="km", subtype='COLOR', default=(0, 0, 0), min=0)
+    highlight: bpy.props.EnumProperty(name="Highlight", items=[('BLINN', "Blinn-Phong", ""), ('PHONG', "Phong", "")])
+
+
+class WhittedLightProps(bpy.types.PropertyGroup):
+    use_intensity: bpy.props.BoolProperty(name="Override intensity", default=False)
+    intensity: bpy.props.FloatVectorProperty(name="Intensity", subtype='COLOR', default=(1, 1, 1), min=0)
+
+
+class WhittedRenderEngine(bpy.types.RenderEngine):
+    bl_idname = "WHITTED"
+    bl_label = "Whitted"
+    bl_use_preview = False
+
+    def render(self, depsgraph):
+        try:
+            text = scene_text(depsgraph)
+            # Kept so a test (or a user) can compare with `whitted render` of exactly this text.
+            WhittedRenderEngine.last_scene_text = text
+            wm = _whitted()
+            scene = wm.loads(text, "<blender>.json")
+        except MappingError as e:
+            self.report({'ERROR'}, str(e))
+            return
+        except Exception as e:  # whitted.Error or ImportError: a message, not a traceback
+            self.report({'ERROR'}, f"Whitted: {e}")
+            return
+        width, height = scene.width, scene.height
+
+        def progress(done, total):
+            self.update_progress(done / total if total else 1.0)
+            if self.test_break():
+                raise KeyboardInterrupt("cancelled")
+
+        result = self.begin_result(0, 0, width, height)
+        try:
+            img = wm.render(scene, threads=depsgraph.scene.whitted.threads, progress=progress)
+        except KeyboardInterrupt:
+            self.end_result(result, cancel=True)
+            return
+        except Exception as e:
+            self.report({'ERROR'}, f"Whitted: {e}")
+            self.end_result(result, cancel=True)
+            return
+        rgba = np.ones((height, width, 4), dtype=np.float32)
+        rgba[:, :, :3] = img[::-1]  # Blender's rows start at the bottom
+        result.layers[0].passes["Combined"].rect = rgba.reshape(-1, 4)
+        self.end_result(result)
+
+
+class EXPORT_SCENE_OT_whitted(bpy.types.Operator):
+    bl_idname = "export_scene.whitted"
+    bl_label = "Export Whitted scene"
+    filepath: bpy.props.StringProperty(subtype='FILE_PATH')
+
+    def execute(self, context):
+        try:
+            text = scene_text(context.evaluated_depsgraph_get())
+        except MappingError as e:
+            self.report({'ERROR'}, str(e))
+            return {'CANCELLED'}
+        with open(self.filepath, "w") as f:
+            f.write(text)
+        return {'FINISHED'}
+
+    def invoke(self, context, event):
+        context.window_manager.fileselect_add(self)
+        return {'RUNNING_MODAL'}
+
+
+def check_pov(context=None):
+    """Export to a temp dir and run whitted.check (POV-Ray); returns (passed, verdict, path)."""
+    context = context or bpy.context
+    d = tempfile.mkdtemp(prefix="whitted-check-")
+    path = os.path.join(d, "scene.json")
+    with open(path, "w") as f:
+        f.write(scene_text(context.evaluated_depsgraph_get()))
+    res = _whitted().check(path, threads=context.scene.whitted.threads)
+    note = f"whitted check: {res.verdict} ({path})"
+    context.scene.render.use_stamp_note = True
+    context.scene.render.stamp_note_text = note
+    return res.passed, res.verdict, path
+
+
+class WHITTED_OT_check_pov(bpy.types.Operator):
+    bl_idname = "whitted.check_pov"
+    bl_label = "Check against POV-Ray"
+
+    def execute(self, context):
+        try:
+            passed, verdict, path = check_pov(context)
+        except Exception as e:
+            self.report({'ERROR'}, f"Whitted: {e}")
+            return {'CANCELLED'}
+        self.report({'INFO'} if passed else {'WARNING'}, f"{verdict} — {path}")
+        return {'FINISHED'}
+
+
+class WHITTED_PT_material(bpy.types.Panel):
+    bl_label = "Whitted"
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "material"
+    COMPAT_ENGINES = {"WHITTED"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.material is not None and context.engine == "WHITTED"
+
+    def draw(self, context):
+        p = context.material.whitted
+        self.layout.prop(p, "use_whitted")
+        for k in ("ka", "kd", "ks", "p", "km", "highlight"):
+            self.layout.prop(p, k)
+
+
+class WHITTED_PT_render(bpy.types.Panel):
+    bl_label = "Whitted"
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "render"
+    COMPAT_ENGINES = {"WHITTED"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine == "WHITTED"
+
+    def draw(self, context):
+        p = context.scene.whitted
+        for k in ("samples", "max_depth", "ambient", "threads"):
+            self.layout.prop(p, k)
+        self.layout.operator("whitted.check_pov")
+
+
+def _menu_export(self, context):
+    self.layout.operator(EXPORT_SCENE_OT_whitted.bl_idname, text="Whitted scene (.json)")
+
+
+_classes = (WhittedSceneProps, WhittedMaterialProps, WhittedLightProps, WhittedRenderEngine,
+            EXPORT_SCENE_OT_whitted, WHITTED_OT_check_pov, WHITTED_PT_material, WHITTED_PT_render)
+
+
+def register():
+    for c in _classes:
+        bpy.utils.register_class(c)
+    bpy.types.Scene.whitted = bpy.props.PointerProperty(type=WhittedSceneProps)
+    bpy.types.Material.whitted = bpy.props.PointerProperty(type=WhittedMaterialProps)
+    bpy.types.Light.whitted = bpy.props.PointerProperty(type=WhittedLightProps)
+    bpy.types.TOPBAR_MT_file_export.append(_menu_export)
+
+
+def unregister():
+    bpy.types.TOPBAR_MT_file_export.remove(_menu_export)
+    del bpy.types.Scene.whitted, bpy.types.Material.whitted, bpy.types.Light.whitted
+    for c in reversed(_classes):
+        bpy.utils.unregister_class(c)

@@ -1,0 +1,114 @@
+"""Build the Whitted scene description from Blender's evaluated depsgraph (needs bpy)."""
+import math
+
+from .mapping import MappingError, horizontal_fov, principled_to_lecture
+
+
+def _matrix_rows(m):
+    return [float(m[i][j]) for i in range(4) for j in range(4)]
+
+
+def _material(mat):
+    if mat is None:
+        return {'kd': 0.8, 'ka': 0.08}
+    props = getattr(mat, 'whitted', None)
+    if props is not None and props.use_whitted:
+        return {'ka': list(props.ka), 'kd': list(props.kd), 'ks': list(props.ks),
+                'p': props.p, 'km': list(props.km), 'highlight': props.highlight.lower()}
+    node = None
+    if mat.use_nodes and mat.node_tree:
+        node = next((n for n in mat.node_tree.nodes if n.type == 'BSDF_PRINCIPLED'), None)
+    if node is None:
+        return principled_to_lecture(mat.diffuse_color, 0.5, mat.roughness, mat.metallic)
+    i = node.inputs
+    return principled_to_lecture(i['Base Color'].default_value, i['Specular'].default_value,
+                                 i['Roughness'].default_value, i['Metallic'].default_value)
+
+
+def _mesh(obj_eval):
+    me = obj_eval.to_mesh()
+    try:
+        me.calc_normals_split()  # why: loop_triangles.split_normals are zero without it
+        me.calc_loop_triangles()
+        smooth = any(p.use_smooth for p in me.polygons)
+        verts, tris, normals = [], [], []
+        for lt in me.loop_triangles:
+            tri = []
+            for k, loop in enumerate(lt.loops):
+                v = me.vertices[lt.vertices[k]].co
+                tri.append(len(verts))
+                verts.append([float(v.x), float(v.y), float(v.z)])
+                n = lt.split_normals[k]
+                normals.append([float(n[0]), float(n[1]), float(n[2])])
+            tris.append(tri)
+        if not tris:
+            return None
+        d = {'type': 'mesh', 'vertices': verts, 'triangles': tris}
+        if smooth:
+            d['normals'] = normals
+        return d
+    finally:
+        obj_eval.to_mesh_clear()
+
+
+def describe(depsgraph):
+    scene = depsgraph.scene
+    r = scene.render
+    width = int(r.resolution_x * r.resolution_percentage / 100)
+    height = int(r.resolution_y * r.resolution_percentage / 100)
+    cam_obj = scene.camera
+    if cam_obj is None:
+        raise MappingError("Whitted: the scene has no active camera")
+    cam = cam_obj.data
+    if cam.shift_x != 0 or cam.shift_y != 0:
+        raise MappingError("Whitted: camera lens shift is not supported (set Shift X/Y to 0)")
+    mw = cam_obj.matrix_world
+    eye = mw.translation
+    fwd = (mw.to_3x3() @ __import__('mathutils').Vector((0, 0, -1))).normalized()
+    up = (mw.to_3x3() @ __import__('mathutils').Vector((0, 1, 0))).normalized()
+    camera = {'eye': list(eye), 'look_at': list(eye + fwd), 'up': list(up)}
+    if cam.type == 'ORTHO':
+        camera['type'] = 'orthographic'
+        camera['view_width'] = cam.ortho_scale if width >= height else cam.ortho_scale * width / height
+    elif cam.type == 'PERSP':
+        camera['fov'] = horizontal_fov(cam.lens, cam.sensor_width, cam.sensor_height,
+                                       cam.sensor_fit, width, height)
+    else:
+        raise MappingError("Whitted: panoramic cameras are not supported")
+    props = scene.whitted
+    world = scene.world
+    bg = [float(c) for c in world.color] if world else [0.0, 0.0, 0.0]
+    desc = {'version': 1, 'camera': camera,
+            'image': {'width': width, 'height': height, 'samples': props.samples, 'background': bg},
+            'render': {'max_depth': props.max_depth}, 'ambient': list(props.ambient),
+            'lights': [], 'materials': {}, 'prototypes': {}, 'objects': []}
+    for inst in depsgraph.object_instances:
+        ob = inst.object
+        if ob.type == 'LIGHT':
+            light = ob.data
+            lp = light.whitted
+            colour = list(lp.intensity) if lp.use_intensity else \
+                [light.energy / (4 * math.pi) * c for c in light.color]
+            if light.type == 'POINT':
+                desc['lights'].append({'type': 'point', 'position': list(inst.matrix_world.translation),
+                                       'intensity': colour})
+            elif light.type == 'SUN':
+                d = inst.matrix_world.to_3x3() @ __import__('mathutils').Vector((0, 0, -1))
+                if lp.use_intensity is False:
+                    colour = [light.energy * c for c in light.color]
+                desc['lights'].append({'type': 'directional', 'direction': list(d), 'intensity': colour})
+            else:
+                raise MappingError(f"Whitted: light '{ob.name}' of type {light.type} is not supported")
+        elif ob.type in {'MESH', 'CURVE', 'SURFACE', 'META', 'FONT'}:
+            name = ob.data.name if ob.data else ob.name
+            if name not in desc['prototypes']:
+                m = _mesh(ob)
+                if m is None:
+                    continue
+                desc['prototypes'][name] = m
+            mat = ob.active_material
+            mname = mat.name if mat else '__default'
+            desc['materials'].setdefault(mname, _material(mat))
+            desc['objects'].append({'type': 'instance', 'prototype': name, 'material': mname,
+                                    'transform': {'matrix': _matrix_rows(inst.matrix_world)}})
+    return desc
