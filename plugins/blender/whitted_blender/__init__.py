@@ -62,20 +62,35 @@ class WhittedRenderEngine(bpy.types.RenderEngine):
     bl_label = "Whitted"
     bl_use_preview = False
 
+    # Set by the export operator: render() then writes the scene text there and renders
+    # nothing. Why: Python cannot make a depsgraph evaluated for render itself, and a
+    # viewport one differs (modifier levels, last-bit vertex differences), so export goes
+    # through the very path render uses.
+    export_path = None
+    last_scene_text = None
+    last_error = None
+    last_cancelled = False
+
     def render(self, depsgraph):
         try:
             text = scene_text(depsgraph)
             # Kept so a test (or a user) can compare with `whitted render` of exactly this text.
             WhittedRenderEngine.last_scene_text = text
+            if WhittedRenderEngine.export_path is not None:
+                with open(WhittedRenderEngine.export_path, "w") as f:
+                    f.write(text)
+                return
             wm = _whitted()
             scene = wm.loads(text, "<blender>.json")
         except MappingError as e:
+            WhittedRenderEngine.last_error = str(e)
             self.report({'ERROR'}, str(e))
             return
         except Exception as e:  # whitted.Error or ImportError: a message, not a traceback
             self.report({'ERROR'}, f"Whitted: {e}")
             return
         width, height = scene.width, scene.height
+        WhittedRenderEngine.last_cancelled = False
 
         def progress(done, total):
             self.update_progress(done / total if total else 1.0)
@@ -86,6 +101,8 @@ class WhittedRenderEngine(bpy.types.RenderEngine):
         try:
             img = wm.render(scene, threads=depsgraph.scene.whitted.threads, progress=progress)
         except KeyboardInterrupt:
+            WhittedRenderEngine.last_cancelled = True
+            self.report({'WARNING'}, "Whitted: render cancelled")
             self.end_result(result, cancel=True)
             return
         except Exception as e:
@@ -98,6 +115,30 @@ class WhittedRenderEngine(bpy.types.RenderEngine):
         self.end_result(result)
 
 
+def export_render_depsgraph(scene, filepath):
+    """Write the scene text the engine would render to `filepath` (see export_path).
+
+    Runs a render with the engine switched to export mode; writes to a temp file first so a
+    failed export never clobbers an existing file. Raises MappingError with the engine's reason.
+    """
+    tmp = filepath + ".part"
+    old_engine = scene.render.engine
+    WhittedRenderEngine.export_path = tmp
+    WhittedRenderEngine.last_scene_text = None
+    WhittedRenderEngine.last_error = None
+    try:
+        scene.render.engine = 'WHITTED'
+        bpy.ops.render.render(scene=scene.name)
+    finally:
+        WhittedRenderEngine.export_path = None
+        scene.render.engine = old_engine
+    if WhittedRenderEngine.last_scene_text is None or not os.path.exists(tmp):
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise MappingError(WhittedRenderEngine.last_error or "Whitted: export failed")
+    os.replace(tmp, filepath)
+
+
 class EXPORT_SCENE_OT_whitted(bpy.types.Operator):
     bl_idname = "export_scene.whitted"
     bl_label = "Export Whitted scene"
@@ -105,12 +146,10 @@ class EXPORT_SCENE_OT_whitted(bpy.types.Operator):
 
     def execute(self, context):
         try:
-            text = scene_text(context.evaluated_depsgraph_get())
+            export_render_depsgraph(context.scene, self.filepath)
         except MappingError as e:
             self.report({'ERROR'}, str(e))
             return {'CANCELLED'}
-        with open(self.filepath, "w") as f:
-            f.write(text)
         return {'FINISHED'}
 
     def invoke(self, context, event):
@@ -123,8 +162,7 @@ def check_pov(context=None):
     context = context or bpy.context
     d = tempfile.mkdtemp(prefix="whitted-check-")
     path = os.path.join(d, "scene.json")
-    with open(path, "w") as f:
-        f.write(scene_text(context.evaluated_depsgraph_get()))
+    export_render_depsgraph(context.scene, path)
     res = _whitted().check(path, threads=context.scene.whitted.threads)
     note = f"whitted check: {res.verdict} ({path})"
     context.scene.render.use_stamp_note = True
