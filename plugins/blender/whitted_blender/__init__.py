@@ -71,6 +71,12 @@ class WhittedRenderEngine(bpy.types.RenderEngine):
     last_error = None
     last_cancelled = False
 
+    def should_break(self):
+        """Blender's Esc/cancel; a plain Python method so a test can replace it (RNA methods
+        such as test_break cannot be overridden from Python, and a background Blender never
+        breaks by itself)."""
+        return self.test_break()
+
     def render(self, depsgraph):
         try:
             text = scene_text(depsgraph)
@@ -94,7 +100,7 @@ class WhittedRenderEngine(bpy.types.RenderEngine):
 
         def progress(done, total):
             self.update_progress(done / total if total else 1.0)
-            if self.test_break():
+            if self.should_break():
                 raise KeyboardInterrupt("cancelled")
 
         result = self.begin_result(0, 0, width, height)
@@ -128,7 +134,12 @@ def export_render_depsgraph(scene, filepath):
     WhittedRenderEngine.last_error = None
     try:
         scene.render.engine = 'WHITTED'
-        bpy.ops.render.render(scene=scene.name)
+        try:
+            bpy.ops.render.render(scene=scene.name)
+        except RuntimeError as e:  # Blender's refusal (no camera) or the engine's report
+            if os.path.exists(tmp):
+                os.remove(tmp)
+            raise MappingError(str(e).removeprefix("Error: ").strip()) from None
     finally:
         WhittedRenderEngine.export_path = None
         scene.render.engine = old_engine
@@ -158,16 +169,23 @@ class EXPORT_SCENE_OT_whitted(bpy.types.Operator):
 
 
 def check_pov(context=None):
-    """Export to a temp dir and run whitted.check (POV-Ray); returns (passed, verdict, path)."""
+    """Export (render depsgraph) to a temp dir and run whitted.check (Whitted vs POV-Ray).
+
+    Returns (passed, verdict, scene_path, report_dir); the verdict and figures go into the
+    render stamp note (scene.render.stamp_note_text).
+    """
     context = context or bpy.context
     d = tempfile.mkdtemp(prefix="whitted-check-")
     path = os.path.join(d, "scene.json")
+    report = os.path.join(d, "report")
     export_render_depsgraph(context.scene, path)
-    res = _whitted().check(path, threads=context.scene.whitted.threads)
-    note = f"whitted check: {res.verdict} ({path})"
+    res = _whitted().check(path, threads=context.scene.whitted.threads, report_dir=report)
+    note = (f"whitted check: {'PASS' if res.passed else 'FAIL'}; "
+            f"{100 * res.fraction_within:.3f}% of pixels within tolerance, "
+            f"max error {res.max_error_codes:g} codes, PSNR {res.psnr:.1f} dB; report {report}")
     context.scene.render.use_stamp_note = True
     context.scene.render.stamp_note_text = note
-    return res.passed, res.verdict, path
+    return res.passed, res.verdict, path, report
 
 
 class WHITTED_OT_check_pov(bpy.types.Operator):
@@ -176,11 +194,11 @@ class WHITTED_OT_check_pov(bpy.types.Operator):
 
     def execute(self, context):
         try:
-            passed, verdict, path = check_pov(context)
+            passed, verdict, path, report = check_pov(context)
         except Exception as e:
             self.report({'ERROR'}, f"Whitted: {e}")
             return {'CANCELLED'}
-        self.report({'INFO'} if passed else {'WARNING'}, f"{verdict} — {path}")
+        self.report({'INFO'} if passed else {'WARNING'}, f"{verdict} — report {report}")
         return {'FINISHED'}
 
 
