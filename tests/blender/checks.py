@@ -51,6 +51,11 @@ if mode == 'errors':
     sc.render.resolution_x, sc.render.resolution_y = 64, 48
     bpy.ops.export_scene.whitted(filepath=e)
     res['persp'] = json.load(open(e))['camera']
+    bgn = sc.world.node_tree.nodes['Background']
+    bgn.inputs['Color'].default_value = (0.25, 0.5, 0.75, 1.0)
+    bgn.inputs['Strength'].default_value = 2.0
+    bpy.ops.export_scene.whitted(filepath=e)
+    res['background'] = json.load(open(e))['image']['background']
 elif mode == 'cancel':
     bpy.ops.mesh.primitive_monkey_add(location=(0, 0, 0))
     bpy.ops.object.light_add(type='POINT', location=(3, 3, 3))

@@ -25,6 +25,7 @@ if mode == "errors":
     assert res["ortho_landscape"]["view_width"] == 5.0, res["ortho_landscape"]  # ortho_scale spans the width
     assert res["ortho_portrait"]["view_width"] == 5.0 * 48 / 64, res["ortho_portrait"]  # ...the height
     assert abs(res["persp"]["fov"] - math.degrees(2 * math.atan(18 / 50))) < 1e-12, res["persp"]
+    assert res["background"] == [0.5, 1.0, 1.5], res["background"]  # Background node Color x Strength 2
     print(f"blender.errors: shift and no-camera refused, file kept; ortho {res['ortho_landscape']['view_width']}"
           f"/{res['ortho_portrait']['view_width']}, fov {res['persp']['fov']}")
 elif mode == "cancel":

@@ -238,12 +238,47 @@ class WHITTED_PT_render(bpy.types.Panel):
         self.layout.operator("whitted.check_pov")
 
 
+class WHITTED_PT_light(bpy.types.Panel):
+    bl_label = "Whitted"
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "data"
+    COMPAT_ENGINES = {"WHITTED"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.light is not None and context.engine == "WHITTED"
+
+    def draw(self, context):
+        light = context.light
+        self.layout.prop(light, "type")
+        self.layout.prop(light, "color")
+        self.layout.prop(light, "energy")
+        self.layout.prop(light.whitted, "use_intensity")
+        self.layout.prop(light.whitted, "intensity")
+
+
+def _compat_panels():
+    """Blender's own panels that EEVEE shows (material surface, world, output, ...), so they
+    show with Whitted too: the add-on reads Principled BSDF inputs and world colour from them.
+    Not the material preview (bl_use_preview is off: there would be nothing in it)."""
+    for name in dir(bpy.types):
+        panel = getattr(bpy.types, name)
+        engines = getattr(panel, "COMPAT_ENGINES", None)
+        if isinstance(engines, set) and "BLENDER_EEVEE" in engines and name != "MATERIAL_PT_preview" \
+                and name.startswith(("MATERIAL_PT", "WORLD_PT", "EEVEE_MATERIAL_PT_context_material",
+                                     "EEVEE_MATERIAL_PT_surface", "EEVEE_WORLD_PT_surface",
+                                     "RENDER_PT_format", "RENDER_PT_color_management",
+                                     "DATA_PT_camera", "DATA_PT_lens", "DATA_PT_context")):
+            yield panel
+
+
 def _menu_export(self, context):
     self.layout.operator(EXPORT_SCENE_OT_whitted.bl_idname, text="Whitted scene (.json)")
 
 
 _classes = (WhittedSceneProps, WhittedMaterialProps, WhittedLightProps, WhittedRenderEngine,
-            EXPORT_SCENE_OT_whitted, WHITTED_OT_check_pov, WHITTED_PT_material, WHITTED_PT_render)
+            EXPORT_SCENE_OT_whitted, WHITTED_OT_check_pov, WHITTED_PT_material, WHITTED_PT_render, WHITTED_PT_light)
 
 
 def register():
@@ -253,9 +288,13 @@ def register():
     bpy.types.Material.whitted = bpy.props.PointerProperty(type=WhittedMaterialProps)
     bpy.types.Light.whitted = bpy.props.PointerProperty(type=WhittedLightProps)
     bpy.types.TOPBAR_MT_file_export.append(_menu_export)
+    for panel in _compat_panels():
+        panel.COMPAT_ENGINES.add("WHITTED")
 
 
 def unregister():
+    for panel in _compat_panels():
+        panel.COMPAT_ENGINES.discard("WHITTED")
     bpy.types.TOPBAR_MT_file_export.remove(_menu_export)
     del bpy.types.Scene.whitted, bpy.types.Material.whitted, bpy.types.Light.whitted
     for c in reversed(_classes):

@@ -90,7 +90,17 @@ def describe(depsgraph):
         raise MappingError("Whitted: panoramic cameras are not supported")
     props = scene.whitted
     world = scene.world
-    bg = [float(c) for c in world.color] if world else [0.0, 0.0, 0.0]
+    bg = [0.0, 0.0, 0.0]
+    if world is not None:
+        bg = [float(c) for c in world.color]
+        # With nodes (the default World), what the UI shows is the Background node's Color x
+        # Strength, not world.color (the viewport colour).
+        node = None
+        if world.use_nodes and world.node_tree:
+            node = next((n for n in world.node_tree.nodes if n.type == 'BACKGROUND'), None)
+        if node is not None:
+            strength = float(node.inputs['Strength'].default_value)
+            bg = [float(c) * strength for c in node.inputs['Color'].default_value[:3]]
     desc = {'version': 1, 'camera': camera,
             'image': {'width': width, 'height': height, 'samples': props.samples, 'background': bg},
             'render': {'max_depth': props.max_depth}, 'ambient': list(props.ambient),
