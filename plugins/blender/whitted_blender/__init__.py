@@ -1,0 +1,301 @@
+"""Whitted as a Blender render engine (docs/blender.md)."""
+bl_info = {
+    "name": "Whitted renderer",
+    "author": "Whitted",
+    "version": (0, 2, 0),
+    "blender": (3, 4, 0),
+    "location": "Render Properties > Render Engine > Whitted",
+    "description": "Renders with the lecture's Whitted model; checks against POV-Ray",
+    "category": "Render",
+}
+
+import os
+import sys
+import tempfile
+
+import bpy
+import numpy as np
+
+from .mapping import MappingError, dumps
+
+
+def _whitted():
+    """Import the `whitted` module; WHITTED_PYTHONPATH is searched first (why: build trees)."""
+    extra = os.environ.get("WHITTED_PYTHONPATH")
+    if extra:
+        for p in reversed(extra.split(os.pathsep)):
+            if p and p not in sys.path:
+                sys.path.insert(0, p)
+    import whitted
+    return whitted
+
+
+def scene_text(depsgraph):
+    from .export import describe
+    return dumps(describe(depsgraph))
+
+
+class WhittedSceneProps(bpy.types.PropertyGroup):
+    samples: bpy.props.IntProperty(name="Samples", default=1, min=1, max=64)
+    max_depth: bpy.props.IntProperty(name="Max depth", default=5, min=1, max=256)
+    ambient: bpy.props.FloatVectorProperty(name="Ambient Ia", subtype='COLOR', default=(0.1, 0.1, 0.1), min=0)
+    threads: bpy.props.IntProperty(name="Threads", default=0, min=0)
+
+
+class WhittedMaterialProps(bpy.types.PropertyGroup):
+    use_whitted: bpy.props.BoolProperty(name="Use these", default=False)
+    ka: bpy.props.FloatVectorProperty(name="ka", subtype='COLOR', default=(0.05, 0.05, 0.05), min=0)
+    kd: bpy.props.FloatVectorProperty(name="kd", subtype='COLOR', default=(0.5, 0.5, 0.5), min=0)
+    ks: bpy.props.FloatVectorProperty(name="ks", subtype='COLOR', default=(0.3, 0.3, 0.3), min=0)
+    p: bpy.props.FloatProperty(name="p", default=50.0, min=1e-3)
+    km: bpy.props.FloatVectorProperty(name="km", subtype='COLOR', default=(0, 0, 0), min=0)
+    highlight: bpy.props.EnumProperty(name="Highlight", items=[('BLINN', "Blinn-Phong", ""), ('PHONG', "Phong", "")])
+
+
+class WhittedLightProps(bpy.types.PropertyGroup):
+    use_intensity: bpy.props.BoolProperty(name="Override intensity", default=False)
+    intensity: bpy.props.FloatVectorProperty(name="Intensity", subtype='COLOR', default=(1, 1, 1), min=0)
+
+
+class WhittedRenderEngine(bpy.types.RenderEngine):
+    bl_idname = "WHITTED"
+    bl_label = "Whitted"
+    bl_use_preview = False
+
+    # Set by the export operator: render() then writes the scene text there and renders
+    # nothing. Why: Python cannot make a depsgraph evaluated for render itself, and a
+    # viewport one differs (modifier levels, last-bit vertex differences), so export goes
+    # through the very path render uses.
+    export_path = None
+    last_scene_text = None
+    last_error = None
+    last_cancelled = False
+
+    def should_break(self):
+        """Blender's Esc/cancel; a plain Python method so a test can replace it (RNA methods
+        such as test_break cannot be overridden from Python, and a background Blender never
+        breaks by itself)."""
+        return self.test_break()
+
+    def render(self, depsgraph):
+        try:
+            text = scene_text(depsgraph)
+            # Kept so a test (or a user) can compare with `whitted render` of exactly this text.
+            WhittedRenderEngine.last_scene_text = text
+            if WhittedRenderEngine.export_path is not None:
+                with open(WhittedRenderEngine.export_path, "w") as f:
+                    f.write(text)
+                return
+            wm = _whitted()
+            scene = wm.loads(text, "<blender>.json")
+        except MappingError as e:
+            WhittedRenderEngine.last_error = str(e)
+            self.report({'ERROR'}, str(e))
+            return
+        except Exception as e:  # whitted.Error or ImportError: a message, not a traceback
+            self.report({'ERROR'}, f"Whitted: {e}")
+            return
+        width, height = scene.width, scene.height
+        WhittedRenderEngine.last_cancelled = False
+
+        def progress(done, total):
+            self.update_progress(done / total if total else 1.0)
+            if self.should_break():
+                raise KeyboardInterrupt("cancelled")
+
+        result = self.begin_result(0, 0, width, height)
+        try:
+            img = wm.render(scene, threads=depsgraph.scene.whitted.threads, progress=progress)
+        except KeyboardInterrupt:
+            WhittedRenderEngine.last_cancelled = True
+            self.report({'WARNING'}, "Whitted: render cancelled")
+            self.end_result(result, cancel=True)
+            return
+        except Exception as e:
+            self.report({'ERROR'}, f"Whitted: {e}")
+            self.end_result(result, cancel=True)
+            return
+        rgba = np.ones((height, width, 4), dtype=np.float32)
+        rgba[:, :, :3] = img[::-1]  # Blender's rows start at the bottom
+        result.layers[0].passes["Combined"].rect = rgba.reshape(-1, 4)
+        self.end_result(result)
+
+
+def export_render_depsgraph(scene, filepath):
+    """Write the scene text the engine would render to `filepath` (see export_path).
+
+    Runs a render with the engine switched to export mode; writes to a temp file first so a
+    failed export never clobbers an existing file. Raises MappingError with the engine's reason.
+    """
+    tmp = filepath + ".part"
+    old_engine = scene.render.engine
+    WhittedRenderEngine.export_path = tmp
+    WhittedRenderEngine.last_scene_text = None
+    WhittedRenderEngine.last_error = None
+    try:
+        scene.render.engine = 'WHITTED'
+        try:
+            bpy.ops.render.render(scene=scene.name)
+        except RuntimeError as e:  # Blender's refusal (no camera) or the engine's report
+            if os.path.exists(tmp):
+                os.remove(tmp)
+            raise MappingError(str(e).removeprefix("Error: ").strip()) from None
+    finally:
+        WhittedRenderEngine.export_path = None
+        scene.render.engine = old_engine
+    if WhittedRenderEngine.last_scene_text is None or not os.path.exists(tmp):
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise MappingError(WhittedRenderEngine.last_error or "Whitted: export failed")
+    os.replace(tmp, filepath)
+
+
+class EXPORT_SCENE_OT_whitted(bpy.types.Operator):
+    bl_idname = "export_scene.whitted"
+    bl_label = "Export Whitted scene"
+    filepath: bpy.props.StringProperty(subtype='FILE_PATH')
+
+    def execute(self, context):
+        try:
+            export_render_depsgraph(context.scene, self.filepath)
+        except MappingError as e:
+            self.report({'ERROR'}, str(e))
+            return {'CANCELLED'}
+        return {'FINISHED'}
+
+    def invoke(self, context, event):
+        context.window_manager.fileselect_add(self)
+        return {'RUNNING_MODAL'}
+
+
+def check_pov(context=None):
+    """Export (render depsgraph) to a temp dir and run whitted.check (Whitted vs POV-Ray).
+
+    Returns (passed, verdict, scene_path, report_dir); the verdict and figures go into the
+    render stamp note (scene.render.stamp_note_text).
+    """
+    context = context or bpy.context
+    d = tempfile.mkdtemp(prefix="whitted-check-")
+    path = os.path.join(d, "scene.json")
+    report = os.path.join(d, "report")
+    export_render_depsgraph(context.scene, path)
+    res = _whitted().check(path, threads=context.scene.whitted.threads, report_dir=report)
+    note = (f"whitted check: {'PASS' if res.passed else 'FAIL'}; "
+            f"{100 * res.fraction_within:.3f}% of pixels within tolerance, "
+            f"max error {res.max_error_codes:g} codes, PSNR {res.psnr:.1f} dB; report {report}")
+    context.scene.render.use_stamp_note = True
+    context.scene.render.stamp_note_text = note
+    return res.passed, res.verdict, path, report
+
+
+class WHITTED_OT_check_pov(bpy.types.Operator):
+    bl_idname = "whitted.check_pov"
+    bl_label = "Check against POV-Ray"
+
+    def execute(self, context):
+        try:
+            passed, verdict, path, report = check_pov(context)
+        except Exception as e:
+            self.report({'ERROR'}, f"Whitted: {e}")
+            return {'CANCELLED'}
+        self.report({'INFO'} if passed else {'WARNING'}, f"{verdict} — report {report}")
+        return {'FINISHED'}
+
+
+class WHITTED_PT_material(bpy.types.Panel):
+    bl_label = "Whitted"
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "material"
+    COMPAT_ENGINES = {"WHITTED"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.material is not None and context.engine == "WHITTED"
+
+    def draw(self, context):
+        p = context.material.whitted
+        self.layout.prop(p, "use_whitted")
+        for k in ("ka", "kd", "ks", "p", "km", "highlight"):
+            self.layout.prop(p, k)
+
+
+class WHITTED_PT_render(bpy.types.Panel):
+    bl_label = "Whitted"
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "render"
+    COMPAT_ENGINES = {"WHITTED"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine == "WHITTED"
+
+    def draw(self, context):
+        p = context.scene.whitted
+        for k in ("samples", "max_depth", "ambient", "threads"):
+            self.layout.prop(p, k)
+        self.layout.operator("whitted.check_pov")
+
+
+class WHITTED_PT_light(bpy.types.Panel):
+    bl_label = "Whitted"
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "data"
+    COMPAT_ENGINES = {"WHITTED"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.light is not None and context.engine == "WHITTED"
+
+    def draw(self, context):
+        light = context.light
+        self.layout.prop(light, "type")
+        self.layout.prop(light, "color")
+        self.layout.prop(light, "energy")
+        self.layout.prop(light.whitted, "use_intensity")
+        self.layout.prop(light.whitted, "intensity")
+
+
+def _compat_panels():
+    """Blender's own panels that EEVEE shows (material surface, world, output, ...), so they
+    show with Whitted too: the add-on reads Principled BSDF inputs and world colour from them.
+    Not the material preview (bl_use_preview is off: there would be nothing in it)."""
+    for name in dir(bpy.types):
+        panel = getattr(bpy.types, name)
+        engines = getattr(panel, "COMPAT_ENGINES", None)
+        if isinstance(engines, set) and "BLENDER_EEVEE" in engines and name != "MATERIAL_PT_preview" \
+                and name.startswith(("MATERIAL_PT", "WORLD_PT", "EEVEE_MATERIAL_PT_context_material",
+                                     "EEVEE_MATERIAL_PT_surface", "EEVEE_WORLD_PT_surface",
+                                     "RENDER_PT_format", "RENDER_PT_color_management",
+                                     "DATA_PT_camera", "DATA_PT_lens", "DATA_PT_context")):
+            yield panel
+
+
+def _menu_export(self, context):
+    self.layout.operator(EXPORT_SCENE_OT_whitted.bl_idname, text="Whitted scene (.json)")
+
+
+_classes = (WhittedSceneProps, WhittedMaterialProps, WhittedLightProps, WhittedRenderEngine,
+            EXPORT_SCENE_OT_whitted, WHITTED_OT_check_pov, WHITTED_PT_material, WHITTED_PT_render, WHITTED_PT_light)
+
+
+def register():
+    for c in _classes:
+        bpy.utils.register_class(c)
+    bpy.types.Scene.whitted = bpy.props.PointerProperty(type=WhittedSceneProps)
+    bpy.types.Material.whitted = bpy.props.PointerProperty(type=WhittedMaterialProps)
+    bpy.types.Light.whitted = bpy.props.PointerProperty(type=WhittedLightProps)
+    bpy.types.TOPBAR_MT_file_export.append(_menu_export)
+    for panel in _compat_panels():
+        panel.COMPAT_ENGINES.add("WHITTED")
+
+
+def unregister():
+    for panel in _compat_panels():
+        panel.COMPAT_ENGINES.discard("WHITTED")
+    bpy.types.TOPBAR_MT_file_export.remove(_menu_export)
+    del bpy.types.Scene.whitted, bpy.types.Material.whitted, bpy.types.Light.whitted
+    for c in reversed(_classes):
+        bpy.utils.unregister_class(c)

@@ -1,0 +1,49 @@
+#!/usr/bin/python3
+"""ctest blender.errors / blender.cancel / blender.check_pov: run tests/blender/checks.py MODE in
+headless Blender and assert on what it recorded. Usage: test_checks.py MODE"""
+import json, math, os, shutil, subprocess, sys, tempfile
+mode = sys.argv[1]
+if shutil.which("blender") is None:
+    print("SKIPPED: blender is not installed (apt-get install blender)"); sys.exit(77)
+if mode == "check_pov" and shutil.which("povray") is None:
+    print("SKIPPED: povray is not installed (apt-get install povray)"); sys.exit(77)
+here = os.path.dirname(os.path.abspath(__file__))
+out = tempfile.mkdtemp(prefix=f"whitted-blender-{mode}-")
+r = subprocess.run(["blender", "-b", "--factory-startup", "--python-exit-code", "1",
+                    "--python", os.path.join(here, "checks.py"), "--", mode, out], capture_output=True, text=True)
+if r.returncode != 0:
+    print(r.stdout[-3000:], r.stderr[-3000:]); sys.exit(1)
+res = json.load(open(os.path.join(out, "result.json")))
+if mode == "errors":
+    assert "camera lens shift is not supported" in res["shift"], res["shift"]
+    assert "Traceback" not in res["shift"], res["shift"]
+    assert "no camera" in res["no_camera"], res["no_camera"]
+    assert "no camera" in res["render_no_camera"], res["render_no_camera"]
+    assert res["kept"] == "old", "a failed export clobbered the existing file"
+    assert not res["part_left"], "a failed export left FILE.part"
+    assert res["ortho_landscape"]["type"] == "orthographic"
+    assert res["ortho_landscape"]["view_width"] == 5.0, res["ortho_landscape"]  # ortho_scale spans the width
+    assert res["ortho_portrait"]["view_width"] == 5.0 * 48 / 64, res["ortho_portrait"]  # ...the height
+    assert abs(res["persp"]["fov"] - math.degrees(2 * math.atan(18 / 50))) < 1e-12, res["persp"]
+    assert res["background"] == [0.5, 1.0, 1.5], res["background"]  # Background node Color x Strength 2
+    print(f"blender.errors: shift and no-camera refused, file kept; ortho {res['ortho_landscape']['view_width']}"
+          f"/{res['ortho_portrait']['view_width']}, fov {res['persp']['fov']}")
+elif mode == "cancel":
+    full_estimate = 16 * res["full_sixteenth_seconds"]  # 800x600x1 is 1/16 of 1600x1200x4
+    assert res["cancelled"], res
+    assert res["calls"]["break"] == 2, res  # the render stopped at the first True
+    assert res["cancel_seconds"] < 0.5 * full_estimate, res
+    assert not res["cancelled_after_full"], res
+    print(f"blender.cancel: cancelled 1600x1200x4 in {res['cancel_seconds']:.2f} s "
+          f"(uncancelled estimate {full_estimate:.1f} s)")
+elif mode == "check_pov":
+    assert res["passed"] is True and res["verdict"].startswith("PASS"), res["verdict"]
+    assert os.path.isfile(res["path"]), res
+    assert os.path.isfile(os.path.join(res["report"], "report.html")), res
+    assert os.path.isfile(os.path.join(res["report"], "metrics.json")), res
+    note = res["note"]
+    assert res["use_stamp_note"] and note.startswith("whitted check: PASS"), note
+    assert "% of pixels within tolerance" in note and "PSNR" in note and res["report"] in note, note
+    print(f"blender.check_pov: {res['verdict']}; stamp note: {note}")
+else:
+    sys.exit(f"unknown mode {mode}")
