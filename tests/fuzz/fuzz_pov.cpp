@@ -15,7 +15,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
-#include <regex>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -76,8 +75,22 @@ const std::set<std::string>& sdl_keywords() {
 
 /// `whitted_prototype_<digits>_<digits>`: the only names the writer makes up.
 bool is_prototype_name(const std::string& word) {
-    static const std::regex name("whitted_prototype_[0-9]+_[0-9]+");
-    return std::regex_match(word, name);
+    static const std::string prefix = "whitted_prototype_";
+    if (word.compare(0, prefix.size(), prefix) != 0) return false;
+    int numbers = 0;
+    size_t i = prefix.size();
+    while (i < word.size()) {  // digits, '_', digits: exactly two runs of digits
+        const size_t start = i;
+        while (i < word.size() && std::isdigit(static_cast<unsigned char>(word[i]))) ++i;
+        if (i == start) return false;
+        ++numbers;
+        if (i < word.size()) {
+            if (word[i] != '_' || numbers == 2) return false;
+            ++i;
+            if (i == word.size()) return false;
+        }
+    }
+    return numbers == 2;
 }
 
 [[noreturn]] void reject(const std::string& sdl, size_t at, const char* why) {
