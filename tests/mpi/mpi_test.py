@@ -433,12 +433,18 @@ def hosts(whitted, directory):
         print(f"SKIPPED: cannot create a network namespace (needs CAP_NET_ADMIN): {e}")
         sys.exit(77)
     try:
-        ip_run("netns", "add", ns[1])
-        ip_run("link", "add", veth[0], "netns", ns[0], "type", "veth", "peer", "name", veth[1], "netns", ns[1])
-        for n, v, a in zip(ns, veth, addresses):
-            ip_run("-n", n, "addr", "add", a + "/24", "dev", v)
-            ip_run("-n", n, "link", "set", v, "up")
-            ip_run("-n", n, "link", "set", "lo", "up")
+        try:
+            ip_run("netns", "add", ns[1])
+            ip_run("link", "add", veth[0], "netns", ns[0], "type", "veth", "peer", "name", veth[1], "netns", ns[1])
+            for n, v, a in zip(ns, veth, addresses):
+                ip_run("-n", n, "addr", "add", a + "/24", "dev", v)
+                ip_run("-n", n, "link", "set", v, "up")
+                ip_run("-n", n, "link", "set", "lo", "up")
+        except RuntimeError as e:
+            # e.g. in a chroot whose / is no mount point, `ip -n` cannot make its mounts private
+            # ("mount --make-rslave /" failed): this host cannot give the namespaces a network.
+            print(f"SKIPPED: cannot set up the two namespaces' network here: {e}")
+            sys.exit(77)
         agent = os.path.join(os.path.dirname(os.path.abspath(__file__)), "netns_agent.sh")
         env = mpi_env()
         env["WHITTED_NETNS_MAP"] = " ".join(f"{a}={n}" for a, n in zip(addresses, ns))
