@@ -202,12 +202,16 @@ class WHITTED_OT_check_pov(bpy.types.Operator):
         return {'FINISHED'}
 
 
-class WHITTED_PT_material(bpy.types.Panel):
+class WhittedPanel:
+    """What every Whitted properties panel shares (a mixin, as Blender's own add-ons write it)."""
     bl_label = "Whitted"
     bl_space_type = 'PROPERTIES'
     bl_region_type = 'WINDOW'
-    bl_context = "material"
     COMPAT_ENGINES = {"WHITTED"}
+
+
+class WHITTED_PT_material(WhittedPanel, bpy.types.Panel):
+    bl_context = "material"
 
     @classmethod
     def poll(cls, context):
@@ -220,12 +224,8 @@ class WHITTED_PT_material(bpy.types.Panel):
             self.layout.prop(p, k)
 
 
-class WHITTED_PT_render(bpy.types.Panel):
-    bl_label = "Whitted"
-    bl_space_type = 'PROPERTIES'
-    bl_region_type = 'WINDOW'
+class WHITTED_PT_render(WhittedPanel, bpy.types.Panel):
     bl_context = "render"
-    COMPAT_ENGINES = {"WHITTED"}
 
     @classmethod
     def poll(cls, context):
@@ -238,12 +238,8 @@ class WHITTED_PT_render(bpy.types.Panel):
         self.layout.operator("whitted.check_pov")
 
 
-class WHITTED_PT_light(bpy.types.Panel):
-    bl_label = "Whitted"
-    bl_space_type = 'PROPERTIES'
-    bl_region_type = 'WINDOW'
+class WHITTED_PT_light(WhittedPanel, bpy.types.Panel):
     bl_context = "data"
-    COMPAT_ENGINES = {"WHITTED"}
 
     @classmethod
     def poll(cls, context):
