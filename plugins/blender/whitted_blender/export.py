@@ -1,6 +1,7 @@
 """Build the Whitted scene description from Blender's evaluated depsgraph (needs bpy)."""
 import math
 
+import mathutils
 import numpy as np
 
 from .mapping import MappingError, horizontal_fov, principled_to_lecture
@@ -10,6 +11,13 @@ def _matrix_rows(m):
     return [float(m[i][j]) for i in range(4) for j in range(4)]
 
 
+def _first_node(owner, node_type):
+    """The first node of `node_type` in a material's or world's node tree, or None without nodes."""
+    if not (owner.use_nodes and owner.node_tree):
+        return None
+    return next((n for n in owner.node_tree.nodes if n.type == node_type), None)
+
+
 def _material(mat):
     if mat is None:
         return {'kd': 0.8, 'ka': 0.08}
@@ -17,9 +25,7 @@ def _material(mat):
     if props is not None and props.use_whitted:
         return {'ka': list(props.ka), 'kd': list(props.kd), 'ks': list(props.ks),
                 'p': props.p, 'km': list(props.km), 'highlight': props.highlight.lower()}
-    node = None
-    if mat.use_nodes and mat.node_tree:
-        node = next((n for n in mat.node_tree.nodes if n.type == 'BSDF_PRINCIPLED'), None)
+    node = _first_node(mat, 'BSDF_PRINCIPLED')
     if node is None:
         return principled_to_lecture(mat.diffuse_color, 0.5, mat.roughness, mat.metallic)
     i = node.inputs
@@ -77,8 +83,8 @@ def describe(depsgraph):
         raise MappingError("Whitted: camera lens shift is not supported (set Shift X/Y to 0)")
     mw = cam_obj.matrix_world
     eye = mw.translation
-    fwd = (mw.to_3x3() @ __import__('mathutils').Vector((0, 0, -1))).normalized()
-    up = (mw.to_3x3() @ __import__('mathutils').Vector((0, 1, 0))).normalized()
+    fwd = (mw.to_3x3() @ mathutils.Vector((0, 0, -1))).normalized()
+    up = (mw.to_3x3() @ mathutils.Vector((0, 1, 0))).normalized()
     camera = {'eye': list(eye), 'look_at': list(eye + fwd), 'up': list(up)}
     if cam.type == 'ORTHO':
         camera['type'] = 'orthographic'
@@ -95,9 +101,7 @@ def describe(depsgraph):
         bg = [float(c) for c in world.color]
         # With nodes (the default World), what the UI shows is the Background node's Color x
         # Strength, not world.color (the viewport colour).
-        node = None
-        if world.use_nodes and world.node_tree:
-            node = next((n for n in world.node_tree.nodes if n.type == 'BACKGROUND'), None)
+        node = _first_node(world, 'BACKGROUND')
         if node is not None:
             strength = float(node.inputs['Strength'].default_value)
             bg = [float(c) * strength for c in node.inputs['Color'].default_value[:3]]
@@ -110,15 +114,14 @@ def describe(depsgraph):
         if ob.type == 'LIGHT':
             light = ob.data
             lp = light.whitted
-            colour = list(lp.intensity) if lp.use_intensity else \
-                [light.energy / (4 * math.pi) * c for c in light.color]
+            # A point light's watts spread over the sphere; a sun's strength is already irradiance.
+            scale = light.energy / (4 * math.pi) if light.type == 'POINT' else light.energy
+            colour = list(lp.intensity) if lp.use_intensity else [scale * c for c in light.color]
             if light.type == 'POINT':
                 desc['lights'].append({'type': 'point', 'position': list(inst.matrix_world.translation),
                                        'intensity': colour})
             elif light.type == 'SUN':
-                d = inst.matrix_world.to_3x3() @ __import__('mathutils').Vector((0, 0, -1))
-                if lp.use_intensity is False:
-                    colour = [light.energy * c for c in light.color]
+                d = inst.matrix_world.to_3x3() @ mathutils.Vector((0, 0, -1))
                 desc['lights'].append({'type': 'directional', 'direction': list(d), 'intensity': colour})
             else:
                 raise MappingError(f"Whitted: light '{ob.name}' of type {light.type} is not supported")
