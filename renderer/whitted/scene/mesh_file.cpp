@@ -785,10 +785,15 @@ void resolve_materials(const std::string& path, ObjContents& contents) {
         } else {
             std::string message = "material " + quote_name(name) + " is not defined";
             if (!read_names.empty()) message += " in " + read_names;
-            for (const MtlFile* mtl : missing)
+            for (const MtlFile* mtl : missing) {
+                // A FIFO or device is never read (it may block or never end): say so, rather than
+                // "not found" for a name the user can see in the folder.
+                std::error_code error;
+                const bool there = std::filesystem::exists(mtl->path, error);
                 message += std::string(message.find(": the MTL file") == std::string::npos ? ": " : "; ") +
                            "the MTL file " + quote_name(mtl->name) + " (mtllib at " + mtl->where.str() +
-                           ") was not found";
+                           (there ? ") is not a regular file" : ") was not found");
+            }
             // did_you_mean writes the name as it is: quote it like the rest of the message.
             const std::string suggestion = did_you_mean(name, defined), head = " (did you mean '";
             if (suggestion.size() > head.size() + 3)

@@ -13,35 +13,12 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 namespace whitted {
 
 std::string read_text_file(const std::string& path, int64_t max_bytes, const std::string& what) {
-    std::error_code error;
-    const auto status = std::filesystem::status(path, error);
-    if (error || !std::filesystem::exists(status)) throw InputError({path}, what + " not found");
-    if (std::filesystem::is_directory(status)) throw InputError({path}, what + " is a directory, not a file");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError({path}, "cannot open the " + what + ": " + std::strerror(errno));
-    in.seekg(0, std::ios::end);
-    const std::streamoff size = in.tellg();
-    if (size > max_bytes)
-        throw InputError({path},
-                         what + " is " + std::to_string(size) + " bytes; the limit is " + std::to_string(max_bytes));
-    in.seekg(0, std::ios::beg);
-    std::string text;
-    if (size > 0) {
-        text.resize(static_cast<size_t>(size));
-        in.read(text.data(), size);
-    } else {  // pipes and other files without a size
-        std::ostringstream buffer;
-        buffer << in.rdbuf();
-        text = buffer.str();
-    }
-    if (in.bad()) throw InputError({path}, "cannot read the " + what + ": " + std::strerror(errno));
-    return text;
+    const MappedTextFile file(path, max_bytes, what);
+    return std::string(file.text());
 }
 
 bool is_plain_ascii(std::string_view text) {
@@ -126,7 +103,12 @@ MappedTextFile::MappedTextFile(const std::string& path, int64_t max_bytes, const
     const auto status = std::filesystem::status(path, error);
     if (error || !std::filesystem::exists(status)) throw InputError({path}, what + " not found");
     if (std::filesystem::is_directory(status)) throw InputError({path}, what + " is a directory, not a file");
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    // Only regular files: a device (/dev/urandom, /dev/zero) has no end to check a limit against,
+    // and opening a FIFO blocks until a writer comes, so a render would hang before any message.
+    // Checked before the open and again on the open descriptor (the path may change in between);
+    // O_NONBLOCK keeps that open from waiting on a FIFO put there meanwhile.
+    if (!std::filesystem::is_regular_file(status)) throw InputError({path}, what + " is not a regular file");
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (fd < 0) throw InputError({path}, "cannot open the " + what + ": " + std::strerror(errno));
     struct stat info {};
     if (::fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) {

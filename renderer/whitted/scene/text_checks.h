@@ -8,8 +8,9 @@
 
 namespace whitted {
 
-/// Reads a whole file, refusing files larger than `max_bytes`, directories and unreadable
-/// paths with an InputError naming the file (`what` says what the file was meant to be).
+/// Reads a whole file, refusing files larger than `max_bytes`, directories, devices, FIFOs and
+/// other files that are not regular, and unreadable paths, with an InputError naming the file
+/// (`what` says what the file was meant to be).
 std::string read_text_file(const std::string& path, int64_t max_bytes, const std::string& what);
 
 /// True when every byte is ASCII and none is NUL: such text needs no closer look.
