@@ -21,6 +21,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -207,8 +208,7 @@ private:
                          texture(material_of(object)) + "\n   " + matrix(to_world) + " }\n";
                 break;
             case ObjectType::box:
-                m_out += "box { " + vec(object.min.value) + ", " + vec(object.max.value) + "\n    " +
-                         texture(material_of(object)) + "\n   " + matrix(to_world) + " }\n";
+                box(object, to_world);
                 break;
             case ObjectType::plane: {
                 // World-space plane computed exactly as Whitted does; POV's `plane { n, d }` is n·x = d.
@@ -234,6 +234,32 @@ private:
                 instance(object, to_world);
                 break;
         }
+    }
+
+    /// A box, in a union that gives POV-Ray a bounding box sure to hold it. POV-Ray keeps each
+    /// object's bounding box in single precision, its corner and size each rounded to the
+    /// nearest float, and tests rays against it with no margin; a ray that crosses the box only
+    /// where that rounding cut the box off (along an edge) is never tested against the box
+    /// (a ray 1.4e-8 above a face's lower edge, at 1e1, passed under the box in POV-Ray; at 1e5
+    /// the cut is 0.0078 wide). A union's bounding box holds those of its children, so two
+    /// spheres of radius 0 (which no ray hits: POV-Ray's test needs a half chord² > 1e-10) at
+    /// the corners of the box's world bounds, pushed out by 8 to 16 floats' spacing, make the
+    /// union's box hold the whole box. `split_union off` keeps POV-Ray from replacing the union
+    /// by its children; a union tests its children without their own bounding boxes.
+    void box(const ObjectDescription& object, const Transform& to_world) {
+        Vec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+        for (int corner = 0; corner < 8; ++corner) {
+            const Vec3 p = to_world.apply_point({corner & 1 ? object.max.value.x : object.min.value.x,
+                                                 corner & 2 ? object.max.value.y : object.min.value.y,
+                                                 corner & 4 ? object.max.value.z : object.min.value.z});
+            for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+        }
+        double scale = 0;
+        for (int a = 0; a < 3; ++a) scale = std::max({scale, std::fabs(lo[a]), std::fabs(hi[a]), hi[a] - lo[a]});
+        const Vec3 pad(std::ldexp(scale, -20) + 1e-30);  // 2^-20: 8 to 16 floats' spacing at `scale`
+        m_out += "union { box { " + vec(object.min.value) + ", " + vec(object.max.value) + "\n    " +
+                 texture(material_of(object)) + "\n   " + matrix(to_world) + " }\n    sphere { " + vec(lo - pad) +
+                 ", 0 } sphere { " + vec(hi + pad) + ", 0 } split_union off }\n";
     }
 
     void mesh_file(const ObjectDescription& object, const Transform& to_world) {

@@ -65,6 +65,7 @@ const std::set<std::string>& sdl_keywords() {
                                              "sky",
                                              "specular",
                                              "sphere",
+                                             "split_union",
                                              "texture",
                                              "translate",
                                              "union",

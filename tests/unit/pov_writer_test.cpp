@@ -139,6 +139,68 @@ TEST(PovWriter, EveryMesh2HasAnInsideVector) {
     }
 }
 
+// POV-Ray keeps an object's bounding box in single precision, corner and size each rounded to
+// the nearest float, and culls rays with it exactly: a bare box lost the rays that cross it only
+// along an edge (tests/pov/box_edge_bounds.yaml). So each box sits in a union (not split) with
+// two radius-0 spheres whose bounding box, rounded as POV-Ray rounds it, holds every corner of
+// the box, turned or not, near the origin and far from it; and no more than a hair larger.
+TEST(PovWriter, BoxSitsInAUnionWhoseFloatBoundingBoxHoldsIt) {
+    const char* cases[][2] = {
+        {"[9.0299, 0.01, -1.0922]", "[9.0699, 0.05, -1.0522]"},
+        {"[100000.3, 70000.1, -40000.7]", "[100001.1, 70000.9, -39999.9]"},
+        {"[-0.02, -0.02, -0.02]", "[0.02, 0.02, 0.02]"},
+    };
+    for (const char* transform :
+         {"", ", transform: [{rotate: {axis: [0, 1, 0], angle: 37.7}}, {translate: [3, 0.03, -2]}]"}) {
+        for (const auto& [min, max] : cases) {
+            const std::string sdl = sdl_for(std::string("objects:\n  - {type: box, min: ") + min + ", max: " + max +
+                                            transform + ", material: {kd: 0.5}}\n");
+            SCOPED_TRACE(sdl);
+            ASSERT_EQ(count_of(sdl, "union { box {"), 1u);
+            EXPECT_EQ(count_of(sdl, "split_union off }"), 1u);
+            const auto lo = numbers_after(sdl, "sphere {", 4),
+                       hi = numbers_after(sdl, "sphere {", 4, sdl.find("sphere {") + 1);
+            EXPECT_EQ(lo[3], 0.0);  // radius 0: no ray hits it
+            EXPECT_EQ(hi[3], 0.0);
+            // The world corners of the box, as Whitted places them.
+            const SceneDescription d = parse_scene_text(
+                std::string("camera: {eye: [0, 1, 5], look_at: [0, 0, 0]}\nimage: {width: 4, height: 3}\nobjects:\n  - "
+                            "{type: box, min: ") +
+                    min + ", max: " + max + transform + ", material: {kd: 0.5}}\n",
+                "scene.yaml");
+            const Scene scene = validate_scene(d);
+            ASSERT_EQ(scene.boxes.size(), 1u);
+            const Box& box = scene.boxes[0];
+            Vec3 low_corner(INFINITY), high_corner(-INFINITY);
+            for (int corner = 0; corner < 8; ++corner) {
+                const Vec3 local{corner & 1 ? box.max.x : box.min.x, corner & 2 ? box.max.y : box.min.y,
+                                 corner & 4 ? box.max.z : box.min.z};
+                const Vec3 world = box.object_to_world ? box.object_to_world->apply_point(local) : local;
+                for (int axis = 0; axis < 3; ++axis) {
+                    low_corner[axis] = std::min(low_corner[axis], world[axis]);
+                    high_corner[axis] = std::max(high_corner[axis], world[axis]);
+                }
+            }
+            double scale = 0;  // the box's size and distance from the origin
+            for (int axis = 0; axis < 3; ++axis)
+                scale = std::max({scale, std::fabs(low_corner[axis]), std::fabs(high_corner[axis]),
+                                  high_corner[axis] - low_corner[axis]});
+            for (int axis = 0; axis < 3; ++axis) {
+                // POV-Ray: each sphere's box is its float centre; the union's is lowerLeft =
+                // float(min), size = float(max - min) over those, tested against lowerLeft + size
+                // summed in float.
+                const float lower = float(lo[axis]);
+                const float size = float(double(float(hi[axis])) - double(lower));
+                const float upper = lower + size;
+                EXPECT_LE(double(lower), low_corner[axis]) << "axis " << axis;
+                EXPECT_GE(double(upper), high_corner[axis]) << "axis " << axis;
+                EXPECT_GE(lo[axis], low_corner[axis] - 1e-5 * scale) << "axis " << axis;  // a hair, not more
+                EXPECT_LE(hi[axis], high_corner[axis] + 1e-5 * scale) << "axis " << axis;
+            }
+        }
+    }
+}
+
 // Awkward doubles (0.1 + 0.2, tiny, huge, many digits) come back bit for bit.
 TEST(PovWriter, NumbersRoundTripExactly) {
     const std::string text =
