@@ -8,6 +8,11 @@ All 1280x960, max_depth 5, one sample per pixel, a glazed mirror floor and two p
   generate.py --many N [--json] [OUT_DIR]        many-N.yaml (or .json): N small spheres on a
                                                  mirror floor, 640x480, one point light, for
                                                  measuring how parsing and memory scale with N
+  generate.py --boxes N [--json] [--turned] [OUT_DIR]
+                                                 boxes-N.yaml (or .json): the same with N small
+                                                 boxes (cubes of side 0.04) instead of spheres;
+                                                 --turned gives each its own turn about y (a
+                                                 transform per object: boxes-turned-N.yaml)
   generate.py --instances N [OUT_DIR]            instances-N.yaml: N placements of the
                                                  100k-triangle torus (one prototype, torus100k.obj)
                                                  on a grid, 640x480, each turned and coloured its
@@ -127,6 +132,56 @@ def many_spheres(out: Path, n: int, as_json: bool) -> Path:
     return path
 
 
+def many_boxes(out: Path, n: int, as_json: bool, turned: bool) -> Path:
+    """N cubes of side 0.04 scattered as many_spheres scatters its spheres, 0.01 above the floor
+    (not on it: coplanar faces would leave the image to rounding), one shared material;
+    with `turned`, each cube is turned about y by its own angle and moved into place by its
+    transform (one transform per object, as procedural scenes write them)."""
+    rng = random.Random(17)
+    side = 10.0
+    if as_json:
+        head = ('{"camera": {"eye": [0, 6, 14], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 60},\n'
+                ' "image": {"width": 640, "height": 480, "background": [0.05, 0.07, 0.1]},\n'
+                ' "lights": [{"type": "point", "position": [-5, 12, 8], "intensity": 1}],\n'
+                ' "materials": {"floor": {"kd": 0.5, "ka": 0.05, "km": 0.4},\n'
+                '               "block": {"kd": [0.2, 0.4, 0.8], "ka": 0.05, "ks": 0.4, "p": 40}},\n'
+                ' "objects": [\n  {"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "material": "floor"}')
+        if turned:
+            item = (',\n  {{"type": "box", "min": [-0.02, -0.02, -0.02], "max": [0.02, 0.02, 0.02], "material": "block", '
+                    '"transform": [{{"rotate": {{"axis": [0, 1, 0], "angle": {:.2f}}}}}, '
+                    '{{"translate": [{:.4f}, 0.03, {:.4f}]}}]}}')
+        else:
+            item = ',\n  {{"type": "box", "min": [{:.4f}, 0.01, {:.4f}], "max": [{:.4f}, 0.05, {:.4f}], "material": "block"}}'
+        tail = "\n]}\n"
+    else:
+        head = ("camera: { eye: [0, 6, 14], look_at: [0, 0, 0], up: [0, 1, 0], fov: 60 }\n"
+                "image: { width: 640, height: 480, background: [0.05, 0.07, 0.1] }\n"
+                "lights:\n  - { type: point, position: [-5, 12, 8], intensity: 1 }\n"
+                "materials:\n  floor: { kd: 0.5, ka: 0.05, km: 0.4 }\n"
+                "  block: { kd: [0.2, 0.4, 0.8], ka: 0.05, ks: 0.4, p: 40 }\n"
+                "objects:\n  - { type: plane, point: [0, 0, 0], normal: [0, 1, 0], material: floor }")
+        if turned:
+            item = ("\n  - {{ type: box, min: [-0.02, -0.02, -0.02], max: [0.02, 0.02, 0.02], material: block, "
+                    "transform: [ {{ rotate: {{ axis: [0, 1, 0], angle: {:.2f} }} }}, {{ translate: [{:.4f}, 0.03, {:.4f}] }} ] }}")
+        else:
+            item = "\n  - {{ type: box, min: [{:.4f}, 0.01, {:.4f}], max: [{:.4f}, 0.05, {:.4f}], material: block }}"
+        tail = "\n"
+
+    def one_box():
+        x, z = rng.uniform(-side, side), rng.uniform(-side, side)
+        if turned:
+            return item.format(rng.uniform(0, 90), x, z)
+        return item.format(x - 0.02, z - 0.02, x + 0.02, z + 0.02)
+
+    path = out / f"boxes-{'turned-' if turned else ''}{n}.{'json' if as_json else 'yaml'}"
+    with path.open("w") as f:
+        f.write(head)
+        for start in range(0, n, 10000):
+            f.write("".join(one_box() for _ in range(min(10000, n - start))))
+        f.write(tail)
+    return path
+
+
 SMALL_HEADER = HEADER.replace("width: 1280, height: 960", "width: 640, height: 480")
 
 
@@ -228,6 +283,14 @@ def main() -> None:
         out = Path(rest[0] if rest else "build/bench")
         out.mkdir(parents=True, exist_ok=True)
         print(many_spheres(out, n, as_json))
+        return
+    if args and args[0] == "--boxes":
+        n = int(args[1])
+        flags = {"--json", "--turned"}
+        rest = [a for a in args[2:] if a not in flags]
+        out = Path(rest[0] if rest else "build/bench")
+        out.mkdir(parents=True, exist_ok=True)
+        print(many_boxes(out, n, "--json" in args[2:], "--turned" in args[2:]))
         return
     one_of = {"--instances": instances, "--torus": torus_scene, "--lights": lights_scene, "--image": image_scene}
     if args and args[0] in one_of:
