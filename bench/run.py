@@ -11,23 +11,18 @@ import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
+import measure
 from povray_input import convert_for_timing
 
 
 def timed(cmd, cwd=None, env=None):
     """Runs cmd, returns (wall seconds, peak resident memory of that process in MB, stderr)."""
-    start = time.perf_counter()
-    proc = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    stderr = proc.stderr.read()
-    _, status, usage = os.wait4(proc.pid, 0)
-    wall = time.perf_counter() - start
-    code = os.waitstatus_to_exitcode(status)
+    wall, peak_mb, code, stderr = measure.timed(cmd, cwd=cwd, env=env)
     if code != 0:
         sys.exit(f"bench: {' '.join(map(str, cmd))} failed ({code}):\n{stderr[-2000:]}")
-    return wall, usage.ru_maxrss / 1024.0, stderr
+    return wall, peak_mb, stderr
 
 
 def main():

@@ -5,7 +5,7 @@ Whitted and POV-Ray 3.7 side by side, one run each, interleaved, on scenes of be
 at several N, with the images compared. Prints a markdown table (docs/performance.md holds the
 measured one).
 
-  bench/scaling.py WHITTED OUT_DIR [--threads T] [--rows spheres,triangles,instances,lights,image]
+  bench/scaling.py WHITTED OUT_DIR [--threads T] [--rows spheres,boxes,triangles,instances,lights,image]
                    [--max-seconds S] [--memory-target]
 
 --memory-target measures the instancing target alone: 1,000 instances of the 100k-triangle
@@ -18,9 +18,9 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
+import measure
 from povray_input import convert_for_timing
 
 HERE = Path(__file__).resolve().parent
@@ -28,6 +28,7 @@ HERE = Path(__file__).resolve().parent
 SERIES = {
     # name: (generate.py option, values, what N counts)
     "spheres": ("--many", [1000, 10000, 100000, 1000000], "spheres"),
+    "boxes": ("--boxes", [1000, 10000, 100000, 1000000], "axis-aligned boxes"),
     "triangles": ("--torus", [100000, 1000000, 10000000], "triangles"),
     "instances": ("--instances", [1, 10, 100, 1000, 10000], "instances of the 100k torus"),
     "lights": ("--lights", [1, 10, 100, 1000], "point lights (100 spheres)"),
@@ -36,16 +37,11 @@ SERIES = {
 
 
 def timed(cmd, cwd=None, env=None):
-    """(wall seconds, peak RSS of the process in MB, exit code): whole process, as /usr/bin/time -v
-    reports it (ru_maxrss of the child)."""
-    start = time.perf_counter()
-    proc = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    stderr = proc.stderr.read()
-    _, status, usage = os.wait4(proc.pid, 0)
-    code = os.waitstatus_to_exitcode(status)
+    """(wall seconds, peak RSS of the process in MB, exit code): whole process (bench/measure.py)."""
+    wall, peak_mb, code, stderr = measure.timed(cmd, cwd=cwd, env=env)
     if code != 0:
         print(f"scaling: {' '.join(map(str, cmd))} failed ({code}): {stderr[-500:]}", file=sys.stderr)
-    return time.perf_counter() - start, usage.ru_maxrss / 1024.0, code
+    return wall, peak_mb, code
 
 
 def generate(option, value, out):
