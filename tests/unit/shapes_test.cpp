@@ -133,6 +133,38 @@ TEST(Box, MissesParallelOutsideSlabAndBehind) {
     EXPECT_FALSE(intersect_box(box, ray_from({3, 0, 6}, {-1, 0, -1}), t_min, t_max, hit));   // passes beside
 }
 
+// Near an edge the face follows POV-Ray's rule (docs/pov-model.md §3, "Box edges"): a ray that
+// meets the −x face δ below the top edge, where the top face's crossing comes δ/|d.y| earlier,
+// is reported on the −x face if that is more than 1e-6 away in t, and otherwise on the face the
+// ray runs more steeply along (the top, for a steep ray; still −x for a shallow one), at the t
+// of the crossing held first (x's). Closed form: the ray passes through (−1, 1 − δ, 0.25).
+TEST(Box, NearAnEdgeTheFaceFollowsPovRaysRule) {
+    const Box box{nullptr, {-1, -1, -1}, {1, 1, 1}, 0};
+    const auto hit_at = [&](double dx, double dy, double delta, ShapeHit& hit) {
+        const Vec3 d = normalize(Vec3{dx, -dy, 0});
+        const Vec3 on_face{-1, 1 - delta, 0.25};
+        return intersect_box(box, ray_from(on_face - d * 4, d), t_min, t_max, hit);
+    };
+    ShapeHit hit;
+    // Steep (|d.y| = 2|d.x|): crossings δ/|d.y| apart.
+    ASSERT_TRUE(hit_at(1, 2, 1e-3, hit));  // 4.5e-4 apart: the face the ray really meets
+    expect_vec_near(hit.normal, {-1, 0, 0}, 0.0);
+    EXPECT_NEAR(hit.t, 4, 1e-12);
+    ASSERT_TRUE(hit_at(1, 2, 1e-7, hit));  // 4.5e-8 apart: one crossing, the steeper face
+    expect_vec_near(hit.normal, {0, 1, 0}, 0.0);
+    EXPECT_NEAR(hit.t, 4, 1e-12);  // x's crossing, the one held first
+    // Shallow (|d.y| = |d.x|/2): the −x face whatever δ.
+    ASSERT_TRUE(hit_at(2, 1, 1e-7, hit));
+    expect_vec_near(hit.normal, {-1, 0, 0}, 0.0);
+    // For z the steepness is weighed against the face held so far: a ray down −z meeting the
+    // +z face 1e-7 inside the +x edge is reported on +z if |d.z| > |d.x|.
+    const Vec3 d = normalize(Vec3{-1, 0, -3});
+    const Vec3 on_face{1 - 1e-7, 0.5, 1};
+    ASSERT_TRUE(intersect_box(box, ray_from(on_face - d * 4, d), t_min, t_max, hit));
+    expect_vec_near(hit.normal, {0, 0, 1}, 0.0);
+    EXPECT_NEAR(hit.t, 4 - 1e-7 * std::sqrt(10.0), 1e-9);  // x's crossing, held first
+}
+
 // A box turned 90° about z: its object x face now faces world +y, with the normal carried along.
 TEST(Box, RotatedBoxNormalFollowsTransform) {
     const Box box{std::make_shared<const Transform>(Transform::rotate({0, 0, 1}, 90)), {-1, -2, -3}, {1, 2, 3}, 0};

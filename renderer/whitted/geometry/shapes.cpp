@@ -71,36 +71,70 @@ bool intersect_sphere(const Sphere& sphere, const Ray& world_ray, double t_min, 
     return true;
 }
 
+namespace {
+
+/// Which face a box hit is on, as 2·axis + (0 for the min face, 1 for the max face); -1 none.
+using BoxFace = int;
+
+/// Near an edge, the face a box hit is reported on follows POV-Ray 3.7's rule (docs/pov-model.md
+/// §3, "Box edges"), so that both renderers shade an edge pixel with the same normal: when a
+/// later axis's crossing is within 1e-6 (in t) of the crossing found so far, that axis's face
+/// takes over if the ray runs more steeply along it. For y the steepness is weighed against x;
+/// for z against the axis of the face held so far.
+bool steeper_face(int axis, BoxFace held, const Vec3& direction) {
+    const double along = std::fabs(direction[axis]);
+    if (axis == 1) return along > std::fabs(direction.x);
+    if (held < 0) return false;
+    return along > std::fabs(direction[held / 2]);
+}
+
+}  // namespace
+
 bool intersect_box(const Box& box, const Ray& world_ray, double t_min, double t_max, ShapeHit& hit) {
     const Ray ray = to_object_space(transform_of(box.object_to_world), world_ray);
-    double t_near = -std::numeric_limits<double>::infinity();
-    double t_far = std::numeric_limits<double>::infinity();
-    int near_axis = -1, far_axis = -1;
-    double near_sign = 0, far_sign = 0;
+    // The slab test, axis by axis in the order x, y, z, with POV-Ray's constants: a direction
+    // component within 1e-10 of 0 is parallel to its slab; crossings within 1e-6 of each other
+    // are one crossing (the t already held is kept, the face may change, steeper_face); the
+    // span starts at t = 0, and an exit before 1e-6 is no hit.
+    constexpr double parallel = 1e-10, close = 1e-6, depth_tolerance = 1e-6;
+    double t_in = 0, t_out = std::numeric_limits<double>::infinity();
+    BoxFace face_in = -1, face_out = -1;
     for (int axis = 0; axis < 3; ++axis) {
         const double o = ray.origin[axis], d = ray.direction[axis];
         const double lo = box.min[axis], hi = box.max[axis];
-        if (d == 0) {
+        if (std::fabs(d) <= parallel) {
             if (o < lo || o > hi) return false;  // parallel to this slab and outside it
             continue;
         }
-        double t0 = (lo - o) / d, t1 = (hi - o) / d;
-        double sign0 = -1, sign1 = 1;  // outward normal of the face each t belongs to
-        if (t0 > t1) std::swap(t0, t1), std::swap(sign0, sign1);
-        if (t0 > t_near) t_near = t0, near_axis = axis, near_sign = sign0;
-        if (t1 < t_far) t_far = t1, far_axis = axis, far_sign = sign1;
-        if (t_near > t_far) return false;
+        const bool backwards = d < 0;  // then the ray leaves through the min face
+        const double t_exit = ((backwards ? lo : hi) - o) / d;
+        const double t_entry = ((backwards ? hi : lo) - o) / d;
+        const BoxFace exit_face = 2 * axis + (backwards ? 0 : 1), entry_face = 2 * axis + (backwards ? 1 : 0);
+        if (t_exit < t_in) return false;
+        const double tie = axis == 0 ? 0.0 : close;  // the first axis has nothing to tie with
+        if (t_exit <= t_out - tie) {
+            t_out = t_exit, face_out = exit_face;
+        } else if (t_exit <= t_out + tie && steeper_face(axis, face_out, ray.direction)) {
+            face_out = exit_face;
+        }
+        if (t_entry >= t_in + tie) {
+            if (t_entry > t_out) return false;
+            t_in = t_entry, face_in = entry_face;
+        } else if (t_entry >= t_in - tie && axis > 0 && steeper_face(axis, face_in, ray.direction)) {
+            face_in = entry_face;
+        }
     }
-    Vec3 object_normal;
-    if (t_near > t_min && t_near < t_max && near_axis >= 0) {
-        hit.t = t_near;
-        object_normal[near_axis] = near_sign;
-    } else if (t_far > t_min && t_far < t_max && far_axis >= 0) {  // the ray starts inside
-        hit.t = t_far;
-        object_normal[far_axis] = far_sign;
+    if (t_out < depth_tolerance) return false;
+    BoxFace face;
+    if (t_in > depth_tolerance && face_in >= 0 && t_in > t_min && t_in < t_max) {
+        hit.t = t_in, face = face_in;
+    } else if (face_out >= 0 && t_out > t_min && t_out < t_max) {  // the ray starts inside
+        hit.t = t_out, face = face_out;
     } else {
         return false;
     }
+    Vec3 object_normal;
+    object_normal[face / 2] = face % 2 ? 1 : -1;
     hit.normal = box.object_to_world ? box.object_to_world->apply_normal(object_normal) : object_normal;
     return true;
 }
