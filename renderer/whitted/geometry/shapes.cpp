@@ -99,6 +99,7 @@ bool intersect_box(const Box& box, const Ray& world_ray, double t_min, double t_
     constexpr double parallel = 1e-10, close = 1e-6, depth_tolerance = 1e-6;
     double t_in = 0, t_out = std::numeric_limits<double>::infinity();
     BoxFace face_in = -1, face_out = -1;
+    bool tie_in = false, tie_out = false;  // the face was switched by the edge rule
     for (int axis = 0; axis < 3; ++axis) {
         const double o = ray.origin[axis], d = ray.direction[axis];
         const double lo = box.min[axis], hi = box.max[axis];
@@ -113,23 +114,23 @@ bool intersect_box(const Box& box, const Ray& world_ray, double t_min, double t_
         if (t_exit < t_in) return false;
         const double tie = axis == 0 ? 0.0 : close;  // the first axis has nothing to tie with
         if (t_exit <= t_out - tie) {
-            t_out = t_exit, face_out = exit_face;
+            t_out = t_exit, face_out = exit_face, tie_out = false;
         } else if (t_exit <= t_out + tie && steeper_face(axis, face_out, ray.direction)) {
-            face_out = exit_face;
+            face_out = exit_face, tie_out = true;
         }
         if (t_entry >= t_in + tie) {
             if (t_entry > t_out) return false;
-            t_in = t_entry, face_in = entry_face;
+            t_in = t_entry, face_in = entry_face, tie_in = false;
         } else if (t_entry >= t_in - tie && axis > 0 && steeper_face(axis, face_in, ray.direction)) {
-            face_in = entry_face;
+            face_in = entry_face, tie_in = true;
         }
     }
     if (t_out < depth_tolerance) return false;
     BoxFace face;
     if (t_in > depth_tolerance && face_in >= 0 && t_in > t_min && t_in < t_max) {
-        hit.t = t_in, face = face_in;
+        hit.t = t_in, face = face_in, hit.edge_tie = tie_in;
     } else if (face_out >= 0 && t_out > t_min && t_out < t_max) {  // the ray starts inside
-        hit.t = t_out, face = face_out;
+        hit.t = t_out, face = face_out, hit.edge_tie = tie_out;
     } else {
         return false;
     }

@@ -14,6 +14,10 @@ struct ShapeHit {
     Vec3 normal;   ///< outward geometric normal, world space, not necessarily unit
     double u = 0;  ///< triangles: barycentric weight of vertex 1
     double v = 0;  ///< triangles: barycentric weight of vertex 2
+    /// Boxes: the face is not the one the ray crosses at `t` but a steeper one within 1e-6,
+    /// chosen by POV-Ray's edge rule (intersect_box); the accelerator lets another box's plain
+    /// hit at the very same t win over it, as POV-Ray's order of testing does.
+    bool edge_tie = false;
 };
 
 bool intersect_sphere(const Sphere& sphere, const Ray& ray, double t_min, double t_max, ShapeHit& hit);

@@ -55,6 +55,9 @@ struct QueryContext {
     /// and its normal, so it is not computed twice (set with it).
     double best_t[Accelerator::packet_size];
     PacketArray<Vec3, Accelerator::packet_size> best_normal;
+    /// Whether that hit's face came from the box edge rule (ShapeHit::edge_tie): another box's
+    /// plain hit at the same t then wins over it (analytic_intersect).
+    bool best_edge_tie[Accelerator::packet_size];
 };
 
 struct AnalyticGeometry {
@@ -100,10 +103,20 @@ void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
         const unsigned id = RTCRayN_id(rays, args->N, i);
         if (!context->is_query(id)) continue;
         const double limit = std::min(context->best_t[id], double(RTCRayN_tfar(rays, args->N, i)));
+        // Overlapping boxes with coplanar faces can be met at the very same t, one of them on a
+        // face the edge rule chose (a ray along one box's edge, inside another's top). POV-Ray
+        // then shows the plain face: it tests the other box first, its bounding box being met
+        // earlier, and keeps the first of equal hits (bench/generate.py --boxes 1000000, row
+        // 383). So a plain hit at the same t replaces an edge-rule one, whatever the order here.
+        const bool equal_may_win = context->best_edge_tie[id] && limit == context->best_t[id];
         ShapeHit hit;
-        if (!intersect_analytic(*geometry, args->primID, context->rays[id], limit, hit)) continue;
+        if (!intersect_analytic(*geometry, args->primID, context->rays[id],
+                                equal_may_win ? std::nextafter(limit, INFINITY) : limit, hit))
+            continue;
+        if (equal_may_win && hit.t == limit && hit.edge_tie) continue;
         context->best_t[id] = hit.t;
         context->best_normal[id] = hit.normal;
+        context->best_edge_tie[id] = hit.edge_tie;
         // Round the float distance up so Embree keeps visiting boxes that may hold a closer hit.
         RTCRayN_tfar(rays, args->N, i) = std::nextafter(float(hit.t), INFINITY);
         RTCHitN_geomID(hits, args->N, i) = args->geomID;
@@ -760,6 +773,7 @@ struct Accelerator::Impl {
         for (int attempt = 0;; ++attempt) {
             QueryContext context(&ray, nullptr, 1, false);
             context.best_t[0] = ray.t_max;
+            context.best_edge_tie[0] = false;
             RTCRayHit rayhit;
             rayhit.ray = make_embree_ray(ray, 0, frame);
             if (rejected >= 0) rayhit.ray.tnear = std::max(rayhit.ray.tnear, std::nextafter(rejected, INFINITY));
@@ -825,6 +839,7 @@ struct Accelerator::Impl {
             any |= is_query;
             if (is_query) {
                 context.best_t[i] = rays[i].t_max;
+                context.best_edge_tie[i] = false;
                 set_lane(packet.ray, lane, rays[i], unsigned(i), frame);
             } else {
                 set_empty_lane(packet.ray, lane, unsigned(i));
