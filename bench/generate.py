@@ -99,87 +99,75 @@ objects:
     (out / f"{name}.yaml").write_text(text)
 
 
-def many_spheres(out: Path, n: int, as_json: bool) -> Path:
-    """N spheres of radius 0.02 scattered over a 20 x 20 square, one shared material; the text
-    is written the way a program would write it (one object a line), in YAML flow style or JSON."""
-    rng = random.Random(13)
-    side = 10.0
+def scattered(path: Path, n: int, as_json: bool, material: str, kd: str, item) -> Path:
+    """Writes `path`: the 640x480 view of a mirror floor under one point light, with n objects
+    scattered over a 20 x 20 square, one shared material (`material`, diffuse colour `kd`); the
+    text is written the way a program would write it (one object a line), in YAML flow style or
+    JSON. `item(as_json)` gives the text of one object, drawing its own random numbers."""
     if as_json:
         head = ('{"camera": {"eye": [0, 6, 14], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 60},\n'
                 ' "image": {"width": 640, "height": 480, "background": [0.05, 0.07, 0.1]},\n'
                 ' "lights": [{"type": "point", "position": [-5, 12, 8], "intensity": 1}],\n'
                 ' "materials": {"floor": {"kd": 0.5, "ka": 0.05, "km": 0.4},\n'
-                '               "ball": {"kd": [0.8, 0.3, 0.2], "ka": 0.05, "ks": 0.4, "p": 40}},\n'
+                f'               "{material}": {{"kd": {kd}, "ka": 0.05, "ks": 0.4, "p": 40}}}},\n'
                 ' "objects": [\n  {"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "material": "floor"}')
-        item = ',\n  {{"type": "sphere", "center": [{:.4f}, 0.02, {:.4f}], "radius": 0.02, "material": "ball"}}'
         tail = "\n]}\n"
     else:
         head = ("camera: { eye: [0, 6, 14], look_at: [0, 0, 0], up: [0, 1, 0], fov: 60 }\n"
                 "image: { width: 640, height: 480, background: [0.05, 0.07, 0.1] }\n"
                 "lights:\n  - { type: point, position: [-5, 12, 8], intensity: 1 }\n"
                 "materials:\n  floor: { kd: 0.5, ka: 0.05, km: 0.4 }\n"
-                "  ball: { kd: [0.8, 0.3, 0.2], ka: 0.05, ks: 0.4, p: 40 }\n"
+                f"  {material}: {{ kd: {kd}, ka: 0.05, ks: 0.4, p: 40 }}\n"
                 "objects:\n  - { type: plane, point: [0, 0, 0], normal: [0, 1, 0], material: floor }")
-        item = "\n  - {{ type: sphere, center: [{:.4f}, 0.02, {:.4f}], radius: 0.02, material: ball }}"
         tail = "\n"
-    path = out / f"many-{n}.{'json' if as_json else 'yaml'}"
     with path.open("w") as f:
         f.write(head)
         for start in range(0, n, 10000):
-            f.write("".join(item.format(rng.uniform(-side, side), rng.uniform(-side, side))
-                            for _ in range(min(10000, n - start))))
+            f.write("".join(item(as_json) for _ in range(min(10000, n - start))))
         f.write(tail)
     return path
+
+
+def many_spheres(out: Path, n: int, as_json: bool) -> Path:
+    """N spheres of radius 0.02 resting on the floor (scattered)."""
+    rng = random.Random(13)
+    side = 10.0
+
+    def sphere(as_json):
+        x, z = rng.uniform(-side, side), rng.uniform(-side, side)
+        if as_json:
+            return f',\n  {{"type": "sphere", "center": [{x:.4f}, 0.02, {z:.4f}], "radius": 0.02, "material": "ball"}}'
+        return f"\n  - {{ type: sphere, center: [{x:.4f}, 0.02, {z:.4f}], radius: 0.02, material: ball }}"
+
+    return scattered(out / f"many-{n}.{'json' if as_json else 'yaml'}", n, as_json, "ball", "[0.8, 0.3, 0.2]", sphere)
 
 
 def many_boxes(out: Path, n: int, as_json: bool, turned: bool) -> Path:
     """N cubes of side 0.04 scattered as many_spheres scatters its spheres, 0.01 above the floor
-    (not on it: coplanar faces would leave the image to rounding), one shared material;
-    with `turned`, each cube is turned about y by its own angle and moved into place by its
-    transform (one transform per object, as procedural scenes write them)."""
+    (not on it: coplanar faces would leave the image to rounding); with `turned`, each cube is
+    turned about y by its own angle and moved into place by its transform (one transform per
+    object, as procedural scenes write them)."""
     rng = random.Random(17)
     side = 10.0
-    if as_json:
-        head = ('{"camera": {"eye": [0, 6, 14], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 60},\n'
-                ' "image": {"width": 640, "height": 480, "background": [0.05, 0.07, 0.1]},\n'
-                ' "lights": [{"type": "point", "position": [-5, 12, 8], "intensity": 1}],\n'
-                ' "materials": {"floor": {"kd": 0.5, "ka": 0.05, "km": 0.4},\n'
-                '               "block": {"kd": [0.2, 0.4, 0.8], "ka": 0.05, "ks": 0.4, "p": 40}},\n'
-                ' "objects": [\n  {"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "material": "floor"}')
-        if turned:
-            item = (',\n  {{"type": "box", "min": [-0.02, -0.02, -0.02], "max": [0.02, 0.02, 0.02], "material": "block", '
-                    '"transform": [{{"rotate": {{"axis": [0, 1, 0], "angle": {:.2f}}}}}, '
-                    '{{"translate": [{:.4f}, 0.03, {:.4f}]}}]}}')
-        else:
-            item = ',\n  {{"type": "box", "min": [{:.4f}, 0.01, {:.4f}], "max": [{:.4f}, 0.05, {:.4f}], "material": "block"}}'
-        tail = "\n]}\n"
-    else:
-        head = ("camera: { eye: [0, 6, 14], look_at: [0, 0, 0], up: [0, 1, 0], fov: 60 }\n"
-                "image: { width: 640, height: 480, background: [0.05, 0.07, 0.1] }\n"
-                "lights:\n  - { type: point, position: [-5, 12, 8], intensity: 1 }\n"
-                "materials:\n  floor: { kd: 0.5, ka: 0.05, km: 0.4 }\n"
-                "  block: { kd: [0.2, 0.4, 0.8], ka: 0.05, ks: 0.4, p: 40 }\n"
-                "objects:\n  - { type: plane, point: [0, 0, 0], normal: [0, 1, 0], material: floor }")
-        if turned:
-            item = ("\n  - {{ type: box, min: [-0.02, -0.02, -0.02], max: [0.02, 0.02, 0.02], material: block, "
-                    "transform: [ {{ rotate: {{ axis: [0, 1, 0], angle: {:.2f} }} }}, {{ translate: [{:.4f}, 0.03, {:.4f}] }} ] }}")
-        else:
-            item = "\n  - {{ type: box, min: [{:.4f}, 0.01, {:.4f}], max: [{:.4f}, 0.05, {:.4f}], material: block }}"
-        tail = "\n"
 
-    def one_box():
+    def box(as_json):
         x, z = rng.uniform(-side, side), rng.uniform(-side, side)
         if turned:
-            return item.format(rng.uniform(0, 90), x, z)
-        return item.format(x - 0.02, z - 0.02, x + 0.02, z + 0.02)
+            angle = rng.uniform(0, 90)
+            if as_json:
+                return (f',\n  {{"type": "box", "min": [-0.02, -0.02, -0.02], "max": [0.02, 0.02, 0.02], '
+                        f'"material": "block", "transform": [{{"rotate": {{"axis": [0, 1, 0], "angle": {angle:.2f}}}}}, '
+                        f'{{"translate": [{x:.4f}, 0.03, {z:.4f}]}}]}}')
+            return (f"\n  - {{ type: box, min: [-0.02, -0.02, -0.02], max: [0.02, 0.02, 0.02], material: block, "
+                    f"transform: [ {{ rotate: {{ axis: [0, 1, 0], angle: {angle:.2f} }} }}, "
+                    f"{{ translate: [{x:.4f}, 0.03, {z:.4f}] }} ] }}")
+        lo, hi = f"[{x - 0.02:.4f}, 0.01, {z - 0.02:.4f}]", f"[{x + 0.02:.4f}, 0.05, {z + 0.02:.4f}]"
+        if as_json:
+            return f',\n  {{"type": "box", "min": {lo}, "max": {hi}, "material": "block"}}'
+        return f"\n  - {{ type: box, min: {lo}, max: {hi}, material: block }}"
 
-    path = out / f"boxes-{'turned-' if turned else ''}{n}.{'json' if as_json else 'yaml'}"
-    with path.open("w") as f:
-        f.write(head)
-        for start in range(0, n, 10000):
-            f.write("".join(one_box() for _ in range(min(10000, n - start))))
-        f.write(tail)
-    return path
+    name = f"boxes-{'turned-' if turned else ''}{n}.{'json' if as_json else 'yaml'}"
+    return scattered(out / name, n, as_json, "block", "[0.2, 0.4, 0.8]", box)
 
 
 SMALL_HEADER = HEADER.replace("width: 1280, height: 960", "width: 640, height: 480")
