@@ -10,6 +10,7 @@
 #include "converters/pov_writer.h"
 
 #include "whitted/core/ray.h"
+#include "whitted/geometry/shapes.h"
 #include "whitted/output/atomic_files.h"
 #include "whitted/scene/mesh_file.h"
 #include "whitted/scene/msh_file.h"
@@ -21,7 +22,6 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
-#include <limits>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -247,13 +247,8 @@ private:
     /// union's box hold the whole box. `split_union off` keeps POV-Ray from replacing the union
     /// by its children; a union tests its children without their own bounding boxes.
     void box(const ObjectDescription& object, const Transform& to_world) {
-        Vec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
-        for (int corner = 0; corner < 8; ++corner) {
-            const Vec3 p = to_world.apply_point({corner & 1 ? object.max.value.x : object.min.value.x,
-                                                 corner & 2 ? object.max.value.y : object.min.value.y,
-                                                 corner & 4 ? object.max.value.z : object.min.value.z});
-            for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
-        }
+        Vec3 lo, hi;
+        world_bounds(to_world, object.min.value, object.max.value, lo, hi);
         double scale = 0;
         for (int a = 0; a < 3; ++a) scale = std::max({scale, std::fabs(lo[a]), std::fabs(hi[a]), hi[a] - lo[a]});
         const Vec3 pad(std::ldexp(scale, -20) + 1e-30);  // 2^-20: 8 to 16 floats' spacing at `scale`

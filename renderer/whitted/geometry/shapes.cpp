@@ -14,18 +14,6 @@ Ray to_object_space(const Transform& to_world, const Ray& ray) {
     return {to_world.inverse_point(ray.origin), to_world.inverse_vector(ray.direction), ray.t_min, ray.t_max};
 }
 
-void bounds_of_transformed_box(const Transform& to_world, const Vec3& lo, const Vec3& hi, Vec3& out_lo, Vec3& out_hi) {
-    constexpr double inf = std::numeric_limits<double>::infinity();
-    out_lo = Vec3(inf);
-    out_hi = Vec3(-inf);
-    for (int corner = 0; corner < 8; ++corner) {
-        const Vec3 p{(corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y, (corner & 4) ? hi.z : lo.z};
-        const Vec3 w = to_world.apply_point(p);
-        out_lo = min(out_lo, w);
-        out_hi = max(out_hi, w);
-    }
-}
-
 }  // namespace
 
 namespace {
@@ -196,15 +184,27 @@ bool hit_triangle_plane(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Ra
     return true;
 }
 
+void world_bounds(const Transform& to_world, const Vec3& lo, const Vec3& hi, Vec3& out_lo, Vec3& out_hi) {
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    out_lo = Vec3(inf);
+    out_hi = Vec3(-inf);
+    for (int corner = 0; corner < 8; ++corner) {
+        const Vec3 p{(corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y, (corner & 4) ? hi.z : lo.z};
+        const Vec3 w = to_world.apply_point(p);
+        out_lo = min(out_lo, w);
+        out_hi = max(out_hi, w);
+    }
+}
+
 void world_bounds(const Sphere& sphere, Vec3& lo, Vec3& hi) {
     lo = sphere.center - Vec3(sphere.radius);
     hi = sphere.center + Vec3(sphere.radius);
     // Embree asks once per sphere while building: the eight corners only when there is a transform.
-    if (sphere.object_to_world) bounds_of_transformed_box(*sphere.object_to_world, Vec3(lo), Vec3(hi), lo, hi);
+    if (sphere.object_to_world) world_bounds(*sphere.object_to_world, Vec3(lo), Vec3(hi), lo, hi);
 }
 
 void world_bounds(const Box& box, Vec3& lo, Vec3& hi) {
-    bounds_of_transformed_box(transform_of(box.object_to_world), box.min, box.max, lo, hi);
+    world_bounds(transform_of(box.object_to_world), box.min, box.max, lo, hi);
 }
 
 }  // namespace whitted

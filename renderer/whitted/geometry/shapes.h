@@ -35,5 +35,8 @@ bool hit_triangle_plane(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Ra
 /// World-space bounds of a sphere or box (its object-space box pushed through the transform).
 void world_bounds(const Sphere& sphere, Vec3& lo, Vec3& hi);
 void world_bounds(const Box& box, Vec3& lo, Vec3& hi);
+/// World-space bounds of the axis-aligned box [lo, hi] of an object's space under `to_world`
+/// (the extremes of its eight corners).
+void world_bounds(const Transform& to_world, const Vec3& lo, const Vec3& hi, Vec3& out_lo, Vec3& out_hi);
 
 }  // namespace whitted
