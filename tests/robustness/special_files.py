@@ -3,8 +3,9 @@
 """Files that are not regular files, given where a scene, mesh, MTL or course .msh file is
 expected (docs/robustness.md): a character device with no end (/dev/zero, /dev/urandom), one
 that is always empty (/dev/null), and a FIFO with no writer, whose plain open() would wait
-forever; and links to such files. Each must be refused at once (exit 2, "not a regular file" and the path in the
-message), by `render`, `convert` and `explain` alike, with no output file written.
+forever; and links to such files. Each must be refused at once (exit 2, "not a regular file"
+and the path in the message), by `render`, `convert` and `explain` alike, with no output file
+written.
 Usage: special_files.py WHITTED"""
 
 import os
