@@ -299,7 +299,7 @@ private:
         world.reserve(vertices.size());
         for (const Vec3& v : vertices) {
             const Vec3 w = to_world.apply_point(v);
-            world.push_back({float(w.x), float(w.y), float(w.z)});
+            world.push_back({float_rounded(w.x), float_rounded(w.y), float_rounded(w.z)});
         }
         const Vec3 centre = mesh_centre(world);
         o += "mesh2 {\n  vertex_vectors { " + std::to_string(vertices.size());
@@ -311,7 +311,7 @@ private:
                 const Vec3 w = to_world.apply_normal(n);
                 const double len = length(w);
                 const Vec3 unit = len > 0 ? w / len : Vec3(1, 0, 0);
-                o += ",\n    " + vec({float(unit.x), float(unit.y), float(unit.z)});
+                o += ",\n    " + vec({float_rounded(unit.x), float_rounded(unit.y), float_rounded(unit.z)});
             }
             o += " }\n";
         }

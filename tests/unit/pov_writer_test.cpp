@@ -119,6 +119,26 @@ TEST(PovWriter, FarMeshWrittenAboutItsOwnCentreWithTheSameFloatVertices) {
               (std::vector<double>{float(0.3), float(0.7), float(-0.1)}));
 }
 
+// Vertex normals are written as the floats Whitted holds (the unit normal rounded to float), so
+// that POV-Ray, which makes each normal it reads unit length again and stores it as a float,
+// ends with the normals Whitted's emulation of it (accelerator.cpp, blended_normal) starts
+// from. The rounding is real: GCC 12's vectoriser once dropped it, and x and y of these
+// normals were written unrounded (vec3.h, float_rounded).
+TEST(PovWriter, NormalsAreWrittenAsFloats) {
+    const std::string sdl = sdl_for(
+        "objects:\n  - {type: mesh, material: {kd: 0.5}, triangles: [[0, 1, 2]], "
+        "vertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]], normals: [[0.3, 0.4, 0.5], [0.3, 0.4, 0.5], [0.1, 0.4, 0.5]]}\n");
+    const auto written = numbers_after(sdl, "normal_vectors { 3,", 9);
+    const Vec3 given[3] = {{0.3, 0.4, 0.5}, {0.3, 0.4, 0.5}, {0.1, 0.4, 0.5}};
+    for (int i = 0; i < 3; ++i) {
+        const Vec3 unit = given[i] / length(given[i]);
+        for (int axis = 0; axis < 3; ++axis) {
+            volatile float single = float(unit[axis]);
+            EXPECT_EQ(written[3 * i + axis], double(single)) << "normal " << i << " axis " << axis;
+        }
+    }
+}
+
 // Every mesh2 carries an inside_vector: only then does POV-Ray's mesh report all of a ray's
 // crossings instead of stopping at the nearest, so a shadow ray that meets the mesh within 1e-3
 // of its start still sees the mesh farther on (docs/pov-model.md §3). That holds for a plain

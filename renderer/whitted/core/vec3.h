@@ -5,6 +5,25 @@
 
 namespace whitted {
 
+/// `x` rounded to the nearest float, as a double. The float passes through an empty asm
+/// statement (or, on other compilers and CPUs, a volatile) because GCC 12's SLP vectoriser (on
+/// from -O2) drops a double → float → double round trip of neighbouring values:
+/// Vec3{float(a.x), float(a.y), float(a.z)} came out with x and y unrounded (seen with g++ 12.2
+/// at -O2 and -O3, not with the vectoriser off). The asm keeps the float in a register, where
+/// a volatile went through memory: POV-Ray's mesh test (shapes.cpp) rounds a dozen values a hit.
+inline double float_rounded(double x) {
+    float f = static_cast<float>(x);
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+    __asm__("" : "+x"(f));
+#elif defined(__GNUC__) && defined(__aarch64__)
+    __asm__("" : "+w"(f));
+#else
+    volatile float held = f;
+    f = held;
+#endif
+    return f;
+}
+
 /// A 3-vector of doubles. Geometry and shading run in double precision because POV-Ray, the
 /// renderer we are checked against, does its geometry in double; float would cost us whole
 /// 16-bit codes on grazing hits.
