@@ -8,8 +8,17 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 
 namespace whitted {
+/// The shape that lost its rounding: a Vec3 of three neighbouring values rounded, in a function
+/// of its own that takes a reference. noipa keeps it so: inlined into the test, or reshaped by
+/// GCC's interprocedural passes, it was vectorised otherwise and kept its rounding.
+[[gnu::noipa]] Vec3 rounded_to_float(const Vec3& a);
+Vec3 rounded_to_float(const Vec3& a) {
+    return {float_rounded(a.x), float_rounded(a.y), float_rounded(a.z)};
+}
+
 namespace {
 
 constexpr double t_min = 1e-4, t_max = 1e7;
@@ -226,32 +235,114 @@ TEST(Triangle, MissesOutsideEdgesAndWhenParallel) {
     EXPECT_NEAR(hit.t, 1.0, 1e-12);
 }
 
-// The fallback for a float hit just over an edge: the plane's distance, whatever the edges and
-// the range say, and the barycentrics pulled back onto the triangle.
-TEST(Triangle, PlaneHitClampsBarycentricsOntoTheTriangle) {
-    const Vec3 v0{0, 0, 0}, v1{1, 0, 0}, v2{0, 1, 0};
+// The margin of the exact test: a ray 1e-9 (in u + v) beyond the edge u + v = 1 misses with the
+// margin of 1e-10 the renderer uses and hits with one of 1e-8; and a ray along the edge that two
+// triangles share, at coordinates double cannot hold exactly, meets at least one of them.
+TEST(Triangle, EdgeMarginIsBarycentric) {
+    const Vec3 v0{0, 0, 0}, v1{1, 0, 0}, v2{0, 1, 0}, v3{1, 1, 0};
     ShapeHit hit;
-    // Outside the edge u + v = 1, at (0.75, 0.5): u = 0.75, v = 0.5 scaled to sum 1.
-    ASSERT_TRUE(hit_triangle_plane(v0, v1, v2, ray_from({0.75, 0.5, 2}, {0, 0, -1}), hit));
-    EXPECT_NEAR(hit.t, 2.0, 1e-12);
-    EXPECT_NEAR(hit.u, 0.6, 1e-12);
-    EXPECT_NEAR(hit.v, 0.4, 1e-12);
-    expect_vec_near(hit.normal, {0, 0, 1}, 1e-12);
-    // Beyond the edge v = 0 (v = -0.25): v becomes 0, u stays.
-    ASSERT_TRUE(hit_triangle_plane(v0, v1, v2, ray_from({0.5, -0.25, 3}, {0, 0, -1}), hit));
-    EXPECT_NEAR(hit.t, 3.0, 1e-12);
-    EXPECT_NEAR(hit.u, 0.5, 1e-12);
-    EXPECT_EQ(hit.v, 0.0);
-    // Inside, it agrees with intersect_triangle.
-    ShapeHit exact;
-    const Ray inside = ray_from({0.2, 0.3, -1}, {0.1, 0, 1});
-    ASSERT_TRUE(intersect_triangle(v0, v1, v2, inside, t_min, t_max, exact));
-    ASSERT_TRUE(hit_triangle_plane(v0, v1, v2, inside, hit));
-    EXPECT_EQ(hit.t, exact.t);
-    EXPECT_EQ(hit.u, exact.u);
-    EXPECT_EQ(hit.v, exact.v);
-    // Parallel to the plane: no answer.
-    EXPECT_FALSE(hit_triangle_plane(v0, v1, v2, ray_from({0.2, 0.2, 1}, {1, 0, 0}), hit));
+    const Ray beyond = ray_from({0.5 + 5e-10, 0.5 + 5e-10, 1}, {0, 0, -1});
+    EXPECT_FALSE(intersect_triangle(v0, v1, v2, beyond, t_min, t_max, hit, 1e-10));
+    EXPECT_TRUE(intersect_triangle(v0, v1, v2, beyond, t_min, t_max, hit, 1e-8));
+    for (int k = 1; k < 1000; ++k) {
+        const double x = k / 1000.0 + 1.0 / 3e6;  // on the shared edge x + y = 1, rounded
+        const Vec3 on_edge{x, 1 - x, 0};
+        const Vec3 direction = normalize(Vec3{1e-3 * std::sin(k), 1e-3 * std::cos(k), -1});
+        const Ray through{on_edge - direction * 2.5, direction, t_min, t_max};
+        ShapeHit a, b;
+        EXPECT_TRUE(intersect_triangle(v0, v1, v2, through, t_min, t_max, a, 1e-10) ||
+                    intersect_triangle(v1, v3, v2, through, t_min, t_max, b, 1e-10))
+            << "x = " << x;
+    }
+}
+
+// POV-Ray's mesh2 triangle (docs/pov-model.md §3, "Mesh triangles"), in closed form: a triangle
+// in the plane z = 0.5 met from z = 2 straight down at depth 1.5, inside at (0.25, 0.25) and
+// outside at (0.8, 0.8) (the plane is still met: `inside` says which); the same for either
+// winding (POV-Ray turns the corners one way before its edge tests); no hit behind the ray
+// (depth below 1e-6), parallel to the plane or on a degenerate triangle.
+TEST(Mesh2Triangle, DepthAndEdgesInClosedForm) {
+    const Vec3 p1{0, 0, 0.5}, p2{1, 0, 0.5}, p3{0, 1, 0.5};
+    for (const bool flipped : {false, true}) {
+        const Vec3& a = flipped ? p2 : p1;
+        const Vec3& b = flipped ? p1 : p2;
+        double depth = 0;
+        bool inside = false;
+        ASSERT_TRUE(intersect_mesh2_triangle(a, b, p3, {0.25, 0.25, 2}, {0, 0, -1}, depth, inside));
+        EXPECT_EQ(depth, 1.5);
+        EXPECT_TRUE(inside);
+        ASSERT_TRUE(intersect_mesh2_triangle(a, b, p3, {0.8, 0.8, 2}, {0, 0, -1}, depth, inside));
+        EXPECT_EQ(depth, 1.5);
+        EXPECT_FALSE(inside);
+        EXPECT_FALSE(intersect_mesh2_triangle(a, b, p3, {0.25, 0.25, 2}, {0, 0, 1}, depth, inside));  // behind
+        EXPECT_FALSE(intersect_mesh2_triangle(a, b, p3, {0.25, 0.25, 2}, {1, 0, 0}, depth, inside));  // parallel
+    }
+    double depth = 0;
+    bool inside = false;
+    EXPECT_FALSE(intersect_mesh2_triangle(p1, p2, p1 + (p2 - p1) * 0.5, {0.25, 0, 2}, {0, 0, -1}, depth, inside));
+}
+
+// The plane is kept in single precision. For the triangle (1, 0, 0), (0, 2, 0), (0, 0, 3) the
+// normal (p3 − p1) × (p2 − p1) is (−6, −3, −2), length 7, so the unit normal n is (−6, −3, −2)/7
+// and the distance −n·p1 = 6/7, none of them a float. For a ray from (0.1, 0.2, 3) along a
+// unit direction d at a grazing 1e-4 rad to the plane the depth is −(D + S·o) / (S·d), with S
+// the unit normal and D the distance each rounded to float (computed here through float
+// variables); the exact depth, from the double plane, is far from it: the float plane's tilt
+// and offset (some 1e-8) divided by the grazing angle, beyond double's rounding by far.
+TEST(Mesh2Triangle, TheDistanceIsTheFloatPlanes) {
+    const Vec3 p1{1, 0, 0}, p2{0, 2, 0}, p3{0, 0, 3};
+    const Vec3 origin{0.1, 0.2, 3};
+    const double seventh = 1.0 / 7;
+    const Vec3 n{-6 * seventh, -3 * seventh, -2 * seventh};
+    const Vec3 in_plane = normalize(cross(n, Vec3{0, 0, 1}));
+    const Vec3 d = normalize(in_plane + n * 1e-4);
+    volatile float s_x = float(n.x), s_y = float(n.y), s_z = float(n.z);
+    volatile float n_dot_p1 = float(n.x * p1.x + n.y * p1.y + n.z * p1.z);
+    const Vec3 s{s_x, s_y, s_z};
+    const double distance = -double(n_dot_p1);
+    const double expected =
+        -(distance + (s.x * origin.x + s.y * origin.y + s.z * origin.z)) / (s.x * d.x + s.y * d.y + s.z * d.z);
+    const double exact = -(dot(n, origin) - dot(n, p1)) / dot(n, d);
+    double depth = 0;
+    bool inside = false;
+    ASSERT_TRUE(intersect_mesh2_triangle(p1, p2, p3, origin, d, depth, inside));
+    EXPECT_NEAR(depth, expected, 1e-12 * std::fabs(expected));
+    EXPECT_GT(std::fabs(depth - exact), 1e-6);
+    EXPECT_LT(std::fabs(depth - exact), 1e-1);
+}
+
+// POV-Ray's smooth normal is the lecture's barycentric blend of the vertex normals, computed
+// its own way: on the plane it agrees with n1·(1 − u − v) + n2·u + n3·v to float precision, at
+// p1 it is n1 itself, and it does not depend on the winding the face was given in.
+TEST(Mesh2SmoothNormal, IsTheBarycentricBlend) {
+    const Vec3 p1{0.2, -0.1, 0.4}, p2{1.3, 0.2, -0.3}, p3{-0.4, 1.1, 0.1};
+    const Vec3 n1 = normalize(Vec3{0.1, 0.2, 1}), n2 = normalize(Vec3{0.5, -0.1, 0.8}),
+               n3 = normalize(Vec3{-0.3, 0.6, 0.7});
+    for (const auto& [u, v] : {std::pair{0.2, 0.3}, std::pair{0.6, 0.1}, std::pair{0.05, 0.9}}) {
+        const Vec3 point = p1 * (1 - u - v) + p2 * u + p3 * v;
+        const Vec3 expected = normalize(n1 * (1 - u - v) + n2 * u + n3 * v);
+        expect_vec_near(normalize(mesh2_smooth_normal(p1, p2, p3, n1, n2, n3, point)), expected, 1e-6);
+        expect_vec_near(normalize(mesh2_smooth_normal(p2, p1, p3, n2, n1, n3, point)), expected, 1e-6);
+    }
+    const Vec3 at_p1 = mesh2_smooth_normal(p1, p2, p3, n1, n2, n3, p1);
+    EXPECT_EQ(at_p1.x, n1.x);
+    EXPECT_EQ(at_p1.y, n1.y);
+    EXPECT_EQ(at_p1.z, n1.z);
+}
+
+// float_rounded keeps the rounding to float of neighbouring values, which GCC 12's SLP
+// vectoriser dropped from Vec3{float(a.x), float(a.y), float(a.z)} (vec3.h): with a plain
+// float conversion in float_rounded this test fails in the Release build (x and y come back
+// unrounded; so does PovWriter.NormalsAreWrittenAsFloats). The
+// inputs are read at run time so that nothing is folded before the vectoriser sees it.
+TEST(FloatRounded, NeighbouringValuesAreEachRounded) {
+    volatile double inputs[3] = {0.42426406871192845, 0.565685424949238, 0.7071067811865476};
+    const Vec3 rounded = rounded_to_float({inputs[0], inputs[1], inputs[2]});
+    for (int axis = 0; axis < 3; ++axis) {
+        volatile float single = float(inputs[axis]);
+        EXPECT_EQ(rounded[axis], double(single)) << "axis " << axis;
+        EXPECT_NE(rounded[axis], inputs[axis]) << "axis " << axis;  // none of the three is a float
+    }
 }
 
 // A small sphere far away: |oc|² and along² agree in nearly every digit, so a test that

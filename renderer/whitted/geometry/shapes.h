@@ -23,14 +23,32 @@ struct ShapeHit {
 bool intersect_sphere(const Sphere& sphere, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
 bool intersect_box(const Box& box, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
 bool intersect_plane(const Plane& plane, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
-/// Möller–Trumbore; the normal is (v1 − v0) × (v2 − v0).
+/// Möller–Trumbore; the normal is (v1 − v0) × (v2 − v0). `edge_margin` widens the triangle by
+/// that much in barycentric terms (u, v ≥ −margin, u + v ≤ 1 + margin): with a small margin a
+/// ray along an edge that two triangles share meets at least one of them despite double's
+/// rounding, which the exact test alone does not promise.
 bool intersect_triangle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Ray& ray, double t_min, double t_max,
-                        ShapeHit& hit);
-/// Where the ray's line meets the triangle's plane, with the barycentric weights clamped onto
-/// the triangle (so the shading normal is interpolated from inside it), whatever t is: for a
-/// hit that a float test found just over an edge that the double test rejects. False only when
-/// the ray is parallel to the plane (or the triangle is degenerate).
-bool hit_triangle_plane(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Ray& ray, ShapeHit& hit);
+                        ShapeHit& hit, double edge_margin = 0);
+/// POV-Ray's own test for a triangle of a mesh2, so that Whitted decides triangle hits as it
+/// does (docs/pov-model.md §3). p1, p2, p3 are the triangle's float vertices in the mesh2's
+/// space, in the order of its face; origin and direction are the ray there (POV-Ray's own ray:
+/// the direction unit length). The plane is kept in single precision, its unit normal and its
+/// distance from the origin each rounded to float; the ray meets that plane at `depth` (along
+/// `direction`), which must be at least 1e-6 and at most 1e7, else false. `inside`: whether the
+/// point there lies inside the triangle as seen along the normal's largest axis, by POV-Ray's
+/// three edge tests in double. A ray within 1e-10 of parallel to the plane (in that float
+/// normal) never meets it. For a ray at a grazing angle θ the float plane moves the point along
+/// the ray by up to about ulp(distance) / θ: at 1e-4 rad and coordinates near 5, by 5e-3.
+bool intersect_mesh2_triangle(const Vec3& p1, const Vec3& p2, const Vec3& p3, const Vec3& origin, const Vec3& direction,
+                              double& depth, bool& inside);
+/// POV-Ray's smooth normal for a mesh2 triangle (vertices p1, p2, p3 and their unit float
+/// normals n1, n2, n3, in the face's order) at `point`, before it is made unit length: the
+/// barycentric blend of the lecture, computed POV-Ray's way (a float vector across the edge
+/// p2 p3 gives the weight u of that edge, the largest axis of p3 − p2 the position v along it,
+/// and n1 + u (n2 − n1 + v (n3 − n2)); n1 itself where u < 1e-10), so that a mirror ray
+/// leaving at a grazing angle leaves as POV-Ray's does.
+Vec3 mesh2_smooth_normal(const Vec3& p1, const Vec3& p2, const Vec3& p3, const Vec3& n1, const Vec3& n2, const Vec3& n3,
+                         const Vec3& point);
 
 /// World-space bounds of a sphere or box (its object-space box pushed through the transform).
 void world_bounds(const Sphere& sphere, Vec3& lo, Vec3& hi);

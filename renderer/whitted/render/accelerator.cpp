@@ -16,6 +16,12 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
+
+#include <sys/mman.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 namespace whitted {
 namespace {
@@ -149,24 +155,79 @@ Vec3 vertex(const TriangleMesh& mesh, uint32_t index) {
     return {p[0], p[1], p[2]};
 }
 
-/// Embree's float test found `prim` of this mesh on some rays; each is kept only if its double
-/// ray meets the triangle's plane within (t_min, t_max). Where Embree's coordinates are large
-/// its float distances are off by more than the minimum distances (ulp(1e4) ≈ 1e-3, the shadow
-/// window), so a surface could find itself again or a blocker at the end of the range be kept
-/// or missed; the range is decided in double, as POV-Ray does, and Embree is handed a wider one
-/// (EmbreeFrame::exact_range). Only the range: whether the ray passes inside the triangle's
-/// edges stays Embree's decision, so a ray through an edge two triangles share is decided as
-/// before.
-/// What triangle_filter needs of a mesh: its triangles and, for a prototype's mesh, the
-/// transform of each instance (by Embree's instance geomID), to take the ray into its space.
+/// What triangle_filter needs of a mesh: its triangles, how they are decided
+/// (decided_as_povray) and, for a prototype's mesh, the transform of each instance (by
+/// Embree's instance geomID), to take the ray into its space.
 struct TriangleGeometry {
     const TriangleMesh* mesh = nullptr;
+    bool as_povray = false;
     const std::vector<const Transform*>* instance_transforms = nullptr;
 };
 
+/// How far past its edges, in barycentric terms, a triangle still counts as hit by the exact
+/// test: far below any ray's float error, and far above double's rounding of u and v, so that
+/// a ray along an edge two triangles share meets at least one of them.
+constexpr double triangle_edge_margin = 1e-10;
+
+/// Whether the triangles of `mesh` are decided by POV-Ray's own test (intersect_mesh2_triangle,
+/// mesh2_smooth_normal), the renderer the cross-check compares with. The exact test differs
+/// from it where a ray grazes a triangle (POV-Ray's single-precision plane moves the hit along
+/// the ray by up to 5e-3, past the shadow window) or passes within about 1e-9 of an edge
+/// (POV-Ray's float planes of two neighbours can leave a crack between them, or overlap): the
+/// instancing bench tori and the 1M-triangle anchor failed the strict rule at such pixels
+/// (docs/validation.md, "Mesh triangles"). POV-Ray's test needs the mesh as POV-Ray reads
+/// it; `whitted convert` writes a mesh whose coordinates reach 16 on some axis about a centre
+/// of its own (pov_writer.cpp, mesh_centre), and such a mesh, whose plane distances POV-Ray
+/// holds in that frame, is decided by the exact test (Möller–Trumbore in double).
+bool decided_as_povray(const TriangleMesh& mesh) {
+    constexpr float moved_by_the_converter = 16;
+    for (size_t i = 0; i < mesh.positions.size(); i += 4)
+        if (!(std::fabs(mesh.positions[i]) < moved_by_the_converter &&
+              std::fabs(mesh.positions[i + 1]) < moved_by_the_converter &&
+              std::fabs(mesh.positions[i + 2]) < moved_by_the_converter))
+            return false;
+    return true;
+}
+
+/// The decision on a triangle candidate, made in double from the scene's own float vertices
+/// and the double ray: the ray passes inside the triangle and meets it within (t_min, t_max),
+/// by POV-Ray's test where `as_povray` (decided_as_povray; for a prototype's triangle,
+/// `instanced`: the ray is in the prototype's space with the world's t, and POV-Ray makes its
+/// direction unit length first), else by the exact one. Embree's float test only proposes
+/// candidates: it is given triangles widened beyond its rounding (Impl::add_mesh), so every
+/// triangle the double ray meets is among them, and the widened parts are refused here.
+/// hit.normal is (v1 − v0) × (v2 − v0); u and v are set by the exact test only (the smooth
+/// normal of POV-Ray's is computed from the point, blended_normal).
+bool hit_triangle_in_double(const TriangleMesh& mesh, unsigned prim, const Ray& ray, bool as_povray, bool instanced,
+                            ShapeHit& hit) {
+    const uint32_t* index = &mesh.indices[3 * size_t(prim)];
+    const Vec3 v0 = vertex(mesh, index[0]), v1 = vertex(mesh, index[1]), v2 = vertex(mesh, index[2]);
+    if (!as_povray) return intersect_triangle(v0, v1, v2, ray, ray.t_min, ray.t_max, hit, triangle_edge_margin);
+    double t = 0;
+    bool inside = false;
+    if (instanced) {
+        const Vec3& d = ray.direction;
+        const double len = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+        const double inverse = 1.0 / len;
+        if (!intersect_mesh2_triangle(v0, v1, v2, ray.origin, {d.x * inverse, d.y * inverse, d.z * inverse}, t, inside))
+            return false;
+        t /= len;
+    } else if (!intersect_mesh2_triangle(v0, v1, v2, ray.origin, ray.direction, t, inside)) {
+        return false;
+    }
+    if (!inside || !(t > ray.t_min && t < ray.t_max)) return false;
+    hit.t = t;
+    hit.u = hit.v = 0;
+    hit.normal = cross(v1 - v0, v2 - v0);
+    return true;
+}
+
+/// Embree's filter for triangle candidates (hit_triangle_in_double): on the meshes' own
+/// geometry when every candidate must be decided as it is met (EmbreeFrame::exact_range, and
+/// shadow rays, whose first accepted candidate ends the search), otherwise on the context of
+/// a ray traced again after its nearest candidate was refused.
 void triangle_filter(const RTCFilterFunctionNArguments* args) {
     const auto* geometry = static_cast<const TriangleGeometry*>(args->geometryUserPtr);
-    const TriangleMesh* mesh = geometry->mesh;
     const auto* context = reinterpret_cast<const QueryContext*>(args->context);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
@@ -176,12 +237,91 @@ void triangle_filter(const RTCFilterFunctionNArguments* args) {
         const Ray ray = inst == RTC_INVALID_GEOMETRY_ID
                             ? context->rays[id]
                             : to_object_space(context->rays[id], *(*geometry->instance_transforms)[inst]);
-        const uint32_t* index = &mesh->indices[3 * size_t(RTCHitN_primID(args->hit, args->N, i))];
         ShapeHit hit;
-        if (!hit_triangle_plane(vertex(*mesh, index[0]), vertex(*mesh, index[1]), vertex(*mesh, index[2]), ray, hit) ||
-            !(hit.t > ray.t_min && hit.t < ray.t_max))
+        if (!hit_triangle_in_double(*geometry->mesh, RTCHitN_primID(args->hit, args->N, i), ray, geometry->as_povray,
+                                    inst != RTC_INVALID_GEOMETRY_ID, hit))
             args->valid[i] = 0;
     }
+}
+
+/// An array for Embree to read (the widened corners, their indices), in anonymous memory that
+/// the kernel maps in whole as it is made (MAP_POPULATE) and zeroes. It is written once, front
+/// to back, right after: touched a page at a time instead, every 4 KiB is a page fault, and on
+/// the virtual machine of docs/performance.md the faults cost more than the writing (widening
+/// a million triangles took 75 ms into rtcSetNewGeometryBuffer's memory, about 16 ms more than
+/// mapping and writing this way).
+template <class T>
+class MappedArray {
+public:
+    MappedArray() = default;
+    /// `count` elements and `padding` bytes after them (zero, as the whole mapping is).
+    MappedArray(size_t count, size_t padding) : m_bytes(count * sizeof(T) + padding) {
+        if (m_bytes == 0) return;
+        void* memory =
+            mmap(nullptr, m_bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+        if (memory == MAP_FAILED) throw std::bad_alloc();
+        m_data = static_cast<T*>(memory);
+    }
+    MappedArray(MappedArray&& other) noexcept
+        : m_data(std::exchange(other.m_data, nullptr)), m_bytes(std::exchange(other.m_bytes, 0)) {}
+    MappedArray& operator=(MappedArray&& other) noexcept {
+        std::swap(m_data, other.m_data);
+        std::swap(m_bytes, other.m_bytes);
+        return *this;
+    }
+    MappedArray(const MappedArray&) = delete;
+    MappedArray& operator=(const MappedArray&) = delete;
+    ~MappedArray() {
+        if (m_data) munmap(m_data, m_bytes);
+    }
+    T* data() const { return m_data; }
+
+private:
+    T* m_data = nullptr;
+    size_t m_bytes = 0;
+};
+
+/// A corner of a widened triangle moves at most this many margins (widen_triangles).
+constexpr double max_corner_move = 64;
+
+/// The corners Embree is given for the triangles of `mesh` (moved by `shift` into Embree's
+/// frame), three per triangle, each triangle on its own and widened: its corners moved out
+/// from its incentre so that every edge lies `margin` further out (a scaling about the incentre
+/// by 1 + margin / inradius, the incentre being an inradius from each edge). A corner's move is
+/// capped at max_corner_move margins, since a needle's tip would go far; the capped triangle
+/// still holds the original, each corner lying on the line from the incentre through the
+/// original one. A degenerate triangle is left as it is: neither test ever hits it.
+void widen_triangles(const TriangleMesh& mesh, const Vec3& shift, double margin, float* corners) {
+    const double cap = max_corner_move * margin;
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, mesh.triangle_count(), 4096), [&](const tbb::blocked_range<size_t>& range) {
+            for (size_t t = range.begin(); t != range.end(); ++t) {
+                const uint32_t* index = &mesh.indices[3 * t];
+                Vec3 p[3];
+                for (int k = 0; k < 3; ++k) p[k] = vertex(mesh, index[k]) + shift;
+                const Vec3 ab = p[1] - p[0], ac = p[2] - p[0], bc = p[2] - p[1];
+                // Each corner is weighed by the length of the side facing it.
+                const double a = std::sqrt(dot(bc, bc)), b = std::sqrt(dot(ac, ac)), c = std::sqrt(dot(ab, ab));
+                const double perimeter = a + b + c;
+                const double twice_area = length(cross(ab, ac));
+                if (twice_area > 0 && margin > 0) {
+                    const Vec3 incentre = (p[0] * a + p[1] * b + p[2] * c) * (1.0 / perimeter);
+                    const double scale = margin * perimeter / twice_area;  // margin / inradius
+                    // The cap is compared squared: a square root only where it applies.
+                    for (Vec3& corner : p) {
+                        const Vec3 out = corner - incentre;
+                        const double squared = dot(out, out);
+                        corner += scale * scale * squared <= cap * cap ? out * scale : out * (cap / std::sqrt(squared));
+                    }
+                }
+                float* c3 = corners + 9 * t;
+                for (int k = 0; k < 3; ++k) {
+                    c3[3 * k] = float(p[k].x);
+                    c3[3 * k + 1] = float(p[k].y);
+                    c3[3 * k + 2] = float(p[k].z);
+                }
+            }
+        });
 }
 
 /// The first error Embree reported. Embree calls record_embree_error from C code, where an
@@ -217,6 +357,11 @@ struct EmbreeFrame {
     /// distance falls just outside the range while its double one is inside still reaches
     /// triangle_filter and the analytic callbacks, which decide the exact range in double.
     bool exact_range = false;
+
+    /// The largest coordinate a ray or a finite shape has in this frame (the camera's included),
+    /// and the diagonal of the box that holds them all, the longest distance a ray travels to a
+    /// shape: together they bound Embree's float error (Impl::triangle_margin).
+    double reach = 0, span = 0;
 
     float t_min(const Ray& ray) const { return exact_range ? 0.0f : float(ray.t_min); }
     float t_max(const Ray& ray) const {
@@ -340,6 +485,30 @@ Vec3 vertex_normal(const TriangleMesh& mesh, uint32_t index) {
     return {n[0], n[1], n[2]};
 }
 
+/// Whether a mesh is decided as POV-Ray decides it (decided_as_povray) and, if so, its vertex
+/// normals as POV-Ray holds them: made unit length again as they are read, then stored as
+/// floats (parse.cpp). Computed once here rather than at each hit (blended_normal).
+struct MeshAsPovray {
+    bool decided = false;
+    std::vector<float> normals;  ///< 3 per vertex; empty unless decided and the mesh has normals
+
+    explicit MeshAsPovray(const TriangleMesh& mesh) : decided(decided_as_povray(mesh)) {
+        if (!decided || mesh.normals.empty()) return;
+        normals.resize(mesh.normals.size());
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.normals.size() / 3, 8192),
+                          [&](const tbb::blocked_range<size_t>& range) {
+                              for (size_t i = range.begin(); i != range.end(); ++i) {
+                                  const Vec3 n = vertex_normal(mesh, uint32_t(i));
+                                  const double inverse = 1.0 / std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
+                                  // Stored into floats: rounded whatever the vectoriser does.
+                                  normals[3 * i] = float(n.x * inverse);
+                                  normals[3 * i + 1] = float(n.y * inverse);
+                                  normals[3 * i + 2] = float(n.z * inverse);
+                              }
+                          });
+    }
+};
+
 /// Embree's own allocations, counted as they happen (--stats reports the peak: the BVH and
 /// its build's scratch memory).
 struct MemoryCount {
@@ -429,6 +598,13 @@ struct Accelerator::Impl {
     /// Top-level geomID → the instance's transform (null for other geometry), for triangle_filter.
     std::vector<const Transform*> instance_transforms;
     std::deque<TriangleGeometry> filter_data;  ///< triangle_filter's user data, one per mesh (stable addresses)
+    /// 0, 1, 2, ... : every mesh's index buffer, its widened triangles having corners of their
+    /// own (widen_triangles), for as many triangles as the largest mesh has.
+    MappedArray<uint32_t> corner_indices;
+    std::vector<MappedArray<float>> widened_corners;  ///< each mesh's (widen_triangles), for Embree
+    /// How POV-Ray holds each mesh of the world, and of each prototype.
+    std::vector<MeshAsPovray> world_povray;
+    std::vector<std::vector<MeshAsPovray>> prototype_povray;
     AnalyticGeometry spheres{ShapeKind::spheres, nullptr, {}};
     AnalyticGeometry boxes{ShapeKind::boxes, nullptr, {}};
     RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;  ///< of the scene and its meshes (build_quality)
@@ -454,11 +630,26 @@ struct Accelerator::Impl {
         // Robust: Embree's watertight triangle test. Its fast one let a ray slip between two
         // triangles of a closed mesh now and then and hit the inside (a black pixel in a lit
         // torus); finish_hit can only refine the candidate Embree proposes, not find a missed one.
-        rtcSetSceneFlags(rtc_scene, RTC_SCENE_FLAG_ROBUST);
+        // Context filter: triangle_filter is set on the context of a ray traced again, and of
+        // shadow rays (Impl::intersect, Impl::occluded).
+        rtcSetSceneFlags(rtc_scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
         frame = choose_frame();
         spheres.offset = boxes.offset = frame.offset;
+        size_t most_triangles = 0;
+        for (const TriangleMesh& mesh : scene.meshes) most_triangles = std::max(most_triangles, mesh.triangle_count());
+        for (const Prototype& prototype : scene.prototypes)
+            for (const TriangleMesh& mesh : prototype.meshes)
+                most_triangles = std::max(most_triangles, mesh.triangle_count());
+        corner_indices = MappedArray<uint32_t>(3 * most_triangles, 0);
+        for (size_t i = 0; i < 3 * most_triangles; ++i) corner_indices.data()[i] = uint32_t(i);
+        for (const TriangleMesh& mesh : scene.meshes) world_povray.emplace_back(mesh);
+        for (const Prototype& prototype : scene.prototypes) {
+            prototype_povray.emplace_back();
+            for (const TriangleMesh& mesh : prototype.meshes) prototype_povray.back().emplace_back(mesh);
+        }
         for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
-            const unsigned id = add_mesh(rtc_scene, scene.meshes[m], Vec3(0.0) - frame.offset);
+            const unsigned id = add_mesh(rtc_scene, scene.meshes[m], world_povray[m].decided, Vec3(0.0) - frame.offset,
+                                         world_triangle_margin());
             record(id, ShapeKind::triangles, m);
         }
         add_instances();
@@ -490,7 +681,7 @@ struct Accelerator::Impl {
 
     /// The frame: centred on the bounds of the scene's finite shapes when they lie further from
     /// the origin than their half extent (the shifted coordinates then keep at least one more
-    /// bit), otherwise the world's, and Embree reads the meshes' own arrays. Where the shifted
+    /// bit), otherwise the world's; widen_triangles writes Embree's corners in it. Where the shifted
     /// coordinates still reach M, Embree's float distances may be off by some ulp(M), 2^-23 M
     /// each: once 16 of them exceed a quarter of the smallest minimum distance (surface_t_min,
     /// 1e-4), that is from M ≈ 13 on, the range of each triangle candidate is decided in double
@@ -546,6 +737,15 @@ struct Accelerator::Impl {
         const double reach = std::max({std::fabs(a.x), std::fabs(a.y), std::fabs(a.z), std::fabs(b.x), std::fabs(b.y),
                                        std::fabs(b.z), local_reach});
         chosen.exact_range = !(16 * std::ldexp(reach, -23) < ray_limits::surface_t_min / 4);
+        // Camera rays start at the eye, or across the image plane for an orthographic camera.
+        const Camera& camera = scene.camera;
+        const auto magnitude = [](const Vec3& v) { return Vec3(std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)); };
+        const Vec3 screen = (magnitude(camera.right) + magnitude(camera.up)) * 0.5;
+        const Vec3 all_lo = min(a, camera.eye - chosen.offset - screen),
+                   all_hi = max(b, camera.eye - chosen.offset + screen);
+        chosen.reach = std::max({reach, std::fabs(all_lo.x), std::fabs(all_lo.y), std::fabs(all_lo.z),
+                                 std::fabs(all_hi.x), std::fabs(all_hi.y), std::fabs(all_hi.z)});
+        chosen.span = length(all_hi - all_lo);
         return chosen;
     }
 
@@ -558,33 +758,41 @@ struct Accelerator::Impl {
         device = nullptr;
     }
 
+    /// How far Embree's float test may stray from the double ray, as a distance at a triangle
+    /// of the world: its ray's origin and direction rounded to float (an ulp of the origin's
+    /// coordinates, and of t for the direction) and its watertight test's float arithmetic on
+    /// the corners and the origin (a few ulps of their coordinates) are each at most
+    /// 2^-24 (reach + span) in Embree's frame (EmbreeFrame). The triangles are widened by
+    /// margin_ulps of those, so that every triangle the double ray meets is among Embree's
+    /// candidates (hit_triangle_in_double decides), unless the ray runs almost in its plane
+    /// across an edge, where the widening seen along the ray shrinks (docs/validation.md).
+    /// Accelerator.EveryTriangleTheDoubleTestAcceptsIsFound finds rays that slip through with
+    /// 2 ulps and none with 4: 16 leaves a factor of 4. Not more, because the widening grows with
+    /// the scene while the triangles do not: with 64, the 10,000 tori of `bench/generate.py
+    /// --instances 10000` were widened by half their inradius, and the candidates Embree then
+    /// proposed and the double test refused cost 70 % more render time (docs/performance.md).
+    static constexpr double margin_ulps = 16;
+    double world_triangle_margin() const { return margin_ulps * std::ldexp(frame.reach + frame.span, -24); }
+
     /// Attaches a triangle mesh to `target` with its vertices moved by `shift` (Embree's
-    /// coordinates: the world minus the frame's offset; a prototype's own, unshifted). Returns
-    /// its geomID there.
-    unsigned add_mesh(RTCScene target, const TriangleMesh& mesh, const Vec3& shift,
+    /// coordinates: the world minus the frame's offset; a prototype's own, unshifted) and its
+    /// triangles widened by `margin` (widen_triangles). Returns its geomID there.
+    unsigned add_mesh(RTCScene target, const TriangleMesh& mesh, bool as_povray, const Vec3& shift, double margin,
                       const std::vector<const Transform*>* transforms = nullptr) {
         RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        if (shift == Vec3(0.0)) {
-            // Shared buffers: Embree reads the scene's own arrays, no copy (positions are padded to 16 bytes).
-            rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.positions.data(), 0,
-                                       4 * sizeof(float), mesh.vertex_count());
-        } else {
-            auto* local = static_cast<float*>(rtcSetNewGeometryBuffer(
-                geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 4 * sizeof(float), mesh.vertex_count()));
-            for (uint32_t i = 0; i < mesh.vertex_count(); ++i) {
-                const Vec3 p = vertex(mesh, i) + shift;
-                local[4 * size_t(i)] = float(p.x);
-                local[4 * size_t(i) + 1] = float(p.y);
-                local[4 * size_t(i) + 2] = float(p.z);
-                local[4 * size_t(i) + 3] = 0.0f;
-            }
-        }
-        rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.indices.data(), 0,
+        const size_t corners = 3 * mesh.triangle_count();
+        // Embree reads the last corner with a 16-byte load: 4 bytes of (zero) padding follow it.
+        widened_corners.emplace_back(3 * corners, sizeof(float));
+        float* local = widened_corners.back().data();
+        if (local) widen_triangles(mesh, shift, margin, local);
+        rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, local, 0, 3 * sizeof(float),
+                                   corners);
+        rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, corner_indices.data(), 0,
                                    3 * sizeof(uint32_t), mesh.triangle_count());
         rtcSetGeometryBuildQuality(geometry, quality);  // Embree builds LOW only if both say so
+        filter_data.push_back({&mesh, as_povray, transforms});
+        rtcSetGeometryUserData(geometry, &filter_data.back());
         if (frame.exact_range) {
-            filter_data.push_back({&mesh, transforms});
-            rtcSetGeometryUserData(geometry, &filter_data.back());
             rtcSetGeometryIntersectFilterFunction(geometry, triangle_filter);
             rtcSetGeometryOccludedFilterFunction(geometry, triangle_filter);
         }
@@ -601,13 +809,32 @@ struct Accelerator::Impl {
     /// transform.
     void add_instances() {
         if (scene.instances.empty()) return;
-        for (const Prototype& prototype : scene.prototypes) {
+        // A prototype's triangles are widened in its own space: by the world's margin taken back
+        // through the instance that shrinks it most (the Frobenius norm of the inverse's linear
+        // part bounds how far a world distance goes), plus the rounding of Embree's float
+        // transform of the ray and of the prototype's own coordinates.
+        std::vector<double> stretch(scene.prototypes.size(), 0.0);
+        for (const Instance& instance : scene.instances) {
+            const Transform& t = instance.object_to_world;
+            const Vec3 x = t.inverse_vector({1, 0, 0}), y = t.inverse_vector({0, 1, 0}),
+                       z = t.inverse_vector({0, 0, 1});
+            stretch[instance.prototype] =
+                std::max(stretch[instance.prototype], std::sqrt(dot(x, x) + dot(y, y) + dot(z, z)));
+        }
+        for (uint32_t p = 0; p < scene.prototypes.size(); ++p) {
+            const Prototype& prototype = scene.prototypes[p];
+            const double own =
+                std::max({std::fabs(prototype.lo.x), std::fabs(prototype.lo.y), std::fabs(prototype.lo.z),
+                          std::fabs(prototype.hi.x), std::fabs(prototype.hi.y), std::fabs(prototype.hi.z)});
+            const double margin = stretch[p] * world_triangle_margin() + margin_ulps * std::ldexp(2 * own, -24);
             RTCScene prototype_scene = rtcNewScene(device);
             prototype_scenes.push_back(prototype_scene);
             rtcSetSceneBuildQuality(prototype_scene, quality);
-            rtcSetSceneFlags(prototype_scene, RTC_SCENE_FLAG_ROBUST);  // watertight, as the world's
-            for (const TriangleMesh& mesh : prototype.meshes)
-                add_mesh(prototype_scene, mesh, Vec3(0.0), &instance_transforms);
+            // Watertight and with the context filter, as the world's.
+            rtcSetSceneFlags(prototype_scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+            for (size_t g = 0; g < prototype.meshes.size(); ++g)
+                add_mesh(prototype_scene, prototype.meshes[g], prototype_povray[p][g].decided, Vec3(0.0),
+                         std::isfinite(margin) ? margin : 0.0, &instance_transforms);
             rtcCommitScene(prototype_scene);
         }
         for (uint32_t i = 0; i < scene.instances.size(); ++i) {
@@ -649,10 +876,13 @@ struct Accelerator::Impl {
     }
 
     /// The smooth shading normal at a triangle hit: the unit vertex normals blended by
-    /// barycentric weight and renormalised, as POV-Ray's mesh2 does. False where the triangle
-    /// is shaded flat, with its face normal: a mesh without normals, three equal vertex normals
-    /// (except under render.convention: course) or a blend of length 0.
-    bool blended_normal(const TriangleMesh& mesh, uint32_t prim, const ShapeHit& hit, Vec3& out) const {
+    /// barycentric weight and renormalised, as POV-Ray's mesh2 does; for a mesh decided as
+    /// POV-Ray decides it (`povray.decided`), computed POV-Ray's way at `point`, the hit in the
+    /// mesh's space, from the normals as POV-Ray holds them (mesh2_smooth_normal). False where
+    /// the triangle is shaded flat, with its face normal: a mesh without normals, three equal
+    /// vertex normals (except under render.convention: course) or a blend of length 0.
+    bool blended_normal(const TriangleMesh& mesh, uint32_t prim, const ShapeHit& hit, const MeshAsPovray& povray,
+                        const Vec3& point, Vec3& out) const {
         if (mesh.normals.empty()) return false;
         const uint32_t* index = &mesh.indices[3 * size_t(prim)];
         const Vec3 n0 = vertex_normal(mesh, index[0]), n1 = vertex_normal(mesh, index[1]),
@@ -660,79 +890,66 @@ struct Accelerator::Impl {
         const Vec3 d1 = n0 - n1, d2 = n0 - n2;
         // The course's convention interpolates always, as its ray tracer does.
         if (dot(d1, d1) <= 1e-10 && dot(d2, d2) <= 1e-10 && scene.convention != Convention::course) return false;
-        const Vec3 blended = n0 * (1.0 - hit.u - hit.v) + n1 * hit.u + n2 * hit.v;
+        const auto as_read = [&](uint32_t i) {
+            const float* n = &povray.normals[3 * size_t(i)];
+            return Vec3(n[0], n[1], n[2]);
+        };
+        const Vec3 blended =
+            povray.decided ? mesh2_smooth_normal(vertex(mesh, index[0]), vertex(mesh, index[1]), vertex(mesh, index[2]),
+                                                 as_read(index[0]), as_read(index[1]), as_read(index[2]), point)
+                           : n0 * (1.0 - hit.u - hit.v) + n1 * hit.u + n2 * hit.v;
         const double len = length(blended);
         if (!(len > 0)) return false;
         out = blended / len;
         return true;
     }
 
-    /// The exact hit on triangle `prim` of `mesh` for a candidate Embree found (u, v, t and
-    /// its normal: Embree's, for a ray parallel to the plane in double). False with `retry`
-    /// set when the double ray meets its plane outside the range (see finish_hit).
-    static bool exact_triangle_hit(const TriangleMesh& mesh, unsigned prim, const Ray& ray, float u, float v, float t,
-                                   const Vec3& embree_normal, ShapeHit& hit, bool& retry) {
-        const uint32_t* index = &mesh.indices[3 * size_t(prim)];
-        const Vec3 v0 = vertex(mesh, index[0]), v1 = vertex(mesh, index[1]), v2 = vertex(mesh, index[2]);
-        const bool inside = intersect_triangle(v0, v1, v2, ray, ray.t_min, ray.t_max, hit);
-        if (!inside && hit_triangle_plane(v0, v1, v2, ray, hit) && !(hit.t > ray.t_min && hit.t < ray.t_max)) {
-            retry = true;
-            return false;
-        }
-        if (!inside && !hit_triangle_plane(v0, v1, v2, ray, hit)) {
-            // Float and double disagree on an edge: the hit is taken where the double ray
-            // meets the triangle's plane (hit_triangle_plane), not from Embree's float
-            // numbers, which differ in the last bits from one instruction set to another.
-            // Only a ray parallel to the plane in double is left with Embree's answer.
-            hit.t = t;
-            hit.u = u;
-            hit.v = v;
-            hit.normal = embree_normal;
-        }
-        return true;
-    }
-
     /// The exact hit for what Embree found on one ray (geom == invalid: nothing), then the planes.
     /// `retry` is set, and nothing is found, when Embree's nearest candidate is a triangle that
-    /// the double ray meets outside its range: a ray leaving a surface at a grazing angle can
-    /// start on (or within rounding of) a neighbouring triangle's plane, which Embree's float
-    /// distance puts past t_min while in double it is 0, behind the ray or too near. Such a
-    /// candidate is no hit; the caller traces the ray again beyond it (intersect_beyond).
+    /// the double test refuses (hit_triangle_in_double): the ray passes through the widened
+    /// margin only, or meets the plane outside the range (a ray leaving a surface at a grazing
+    /// angle can start on, or within rounding of, a neighbouring triangle's plane, which Embree's
+    /// float distance puts past t_min while in double it is 0, behind the ray or too near). The
+    /// caller traces the ray again with the double test as Embree's filter (intersect_again).
     /// `inst`: Embree's instance geomID when the candidate is a prototype's triangle (`geom` is
     /// then its mesh in the prototype), else RTC_INVALID_GEOMETRY_ID.
-    bool finish_hit(const Ray& ray, unsigned inst, unsigned geom, unsigned prim, float u, float v, float t,
-                    const Vec3& embree_normal, double best_t, const Vec3& best_normal, SurfaceHit& out,
-                    bool& retry) const {
+    bool finish_hit(const Ray& ray, unsigned inst, unsigned geom, unsigned prim, double best_t, const Vec3& best_normal,
+                    SurfaceHit& out, bool& retry) const {
         retry = false;
         bool found = false;
         double t_max = ray.t_max;
         ShapeHit hit;
         if (geom != RTC_INVALID_GEOMETRY_ID) {
             if (inst != RTC_INVALID_GEOMETRY_ID) {
-                // A prototype's triangle, tested in double in the prototype's space (Embree's
-                // normal is in that space too), its normals then taken to the world with the
-                // inverse transpose. A plain copy's face normal is (v1 − v0) × (v2 − v0) of the
-                // world vertices, which is the transformed one times the sign of the determinant.
+                // A prototype's triangle, tested in double in the prototype's space, its normals
+                // then taken to the world with the inverse transpose. A plain copy's face
+                // normal is (v1 − v0) × (v2 − v0) of the world vertices, which is the
+                // transformed one times the sign of the determinant.
                 const Instance& instance = scene.instances[mesh_of_geometry[inst]];
                 const Transform& to_world = instance.object_to_world;
                 const TriangleMesh& mesh = scene.prototypes[instance.prototype].meshes[geom];
-                if (!exact_triangle_hit(mesh, prim, to_object_space(ray, to_world), u, v, t, embree_normal, hit, retry))
-                    return false;
+                const MeshAsPovray& povray = prototype_povray[instance.prototype][geom];
+                if (!hit_triangle_in_double(mesh, prim, to_object_space(ray, to_world), povray.decided, true, hit))
+                    return retry = true, false;
                 const double handedness = to_world.determinant() < 0 ? -1.0 : 1.0;
                 out.geometric_normal = normalize(to_world.apply_normal(hit.normal)) * handedness;
                 Vec3 smooth;
-                out.normal = blended_normal(mesh, prim, hit, smooth) ? normalize(to_world.apply_normal(smooth))
-                                                                     : out.geometric_normal;
+                // POV-Ray takes the world point back into the mesh's space for its normal.
+                out.normal = blended_normal(mesh, prim, hit, povray, to_world.inverse_point(ray.at(hit.t)), smooth)
+                                 ? normalize(to_world.apply_normal(smooth))
+                                 : out.geometric_normal;
                 out.material = instance.material != Instance::no_material ? instance.material
                                : mesh.triangle_materials.empty()          ? mesh.material
                                                                           : mesh.triangle_materials[prim];
                 out.object = instance.object;
             } else if (kinds[geom] == ShapeKind::triangles) {
                 const TriangleMesh& mesh = scene.meshes[mesh_of_geometry[geom]];
-                if (!exact_triangle_hit(mesh, prim, ray, u, v, t, embree_normal, hit, retry)) return false;
+                const MeshAsPovray& povray = world_povray[mesh_of_geometry[geom]];
+                if (!hit_triangle_in_double(mesh, prim, ray, povray.decided, false, hit)) return retry = true, false;
                 out.geometric_normal = normalize(hit.normal);
                 Vec3 smooth;
-                out.normal = blended_normal(mesh, prim, hit, smooth) ? smooth : out.geometric_normal;
+                out.normal =
+                    blended_normal(mesh, prim, hit, povray, ray.at(hit.t), smooth) ? smooth : out.geometric_normal;
                 out.material = mesh.triangle_materials.empty() ? mesh.material : mesh.triangle_materials[prim];
                 out.object = mesh.object;
             } else {
@@ -763,38 +980,39 @@ struct Accelerator::Impl {
         return found;
     }
 
-    bool intersect(const Ray& ray, SurfaceHit& out) const { return intersect_beyond(ray, -1.0f, out); }
-
-    /// intersect(), with Embree's float range starting past `rejected` (a candidate distance
-    /// finish_hit refused; negative: none). Embree returns its nearest candidate, so every
-    /// other candidate lies at or past that float distance, and starting just past it loses
-    /// none but exact ties. The double range, and the planes, are still decided against `ray`.
-    bool intersect_beyond(const Ray& ray, float rejected, SurfaceHit& out) const {
-        for (int attempt = 0;; ++attempt) {
-            QueryContext context(&ray, nullptr, 1, false);
-            context.best_t[0] = ray.t_max;
-            context.best_edge_tie[0] = false;
-            RTCRayHit rayhit;
-            rayhit.ray = make_embree_ray(ray, 0, frame);
-            if (rejected >= 0) rayhit.ray.tnear = std::max(rayhit.ray.tnear, std::nextafter(rejected, INFINITY));
-            rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-            rtcIntersect1(rtc_scene, &context.embree, &rayhit);
-            bool retry = false;
-            const bool found =
-                finish_hit(ray, rayhit.hit.instID[0], rayhit.hit.geomID, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v,
-                           rayhit.ray.tfar, {rayhit.hit.Ng_x, rayhit.hit.Ng_y, rayhit.hit.Ng_z}, context.best_t[0],
-                           context.best_normal[0], out, retry);
-            // A bounded number of refusals in a row (a fan of grazing neighbours); past it the
-            // planes alone answer, as if the triangles had been missed.
-            if (!retry) return found;
-            rejected = rayhit.ray.tfar;
-            if (attempt == max_refused_candidates)
-                return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, 0, 0, {}, 0, {}, out,
-                                  retry);
-        }
+    /// The nearest hit on `ray`: Embree's nearest candidate, when the double test accepts it.
+    bool intersect(const Ray& ray, SurfaceHit& out) const {
+        bool retry = false;
+        const bool found = trace(ray, nullptr, out, retry);
+        return retry ? intersect_again(ray, out) : found;
     }
-    static constexpr int max_refused_candidates = 8;
+
+    /// The nearest hit on a ray whose nearest candidate the double test refused (finish_hit):
+    /// traced again with that test as Embree's filter, so that Embree goes on past every
+    /// refused candidate to the nearest accepted one. Only such rays pay for the filter's call
+    /// per candidate (a few percent of the rays that meet a mesh, those near an edge).
+    bool intersect_again(const Ray& ray, SurfaceHit& out) const {
+        bool retry = false;
+        const bool found = trace(ray, triangle_filter, out, retry);
+        if (!retry) return found;
+        // Not expected (the filter refuses what finish_hit would); if it came, the planes answer.
+        return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, {}, out, retry);
+    }
+
+    /// One Embree query for `ray` with `filter` on its context (null: none), and finish_hit.
+    bool trace(const Ray& ray, RTCFilterFunctionN filter, SurfaceHit& out, bool& retry) const {
+        QueryContext context(&ray, nullptr, 1, false);
+        context.embree.filter = filter;
+        context.best_t[0] = ray.t_max;
+        context.best_edge_tie[0] = false;
+        RTCRayHit rayhit;
+        rayhit.ray = make_embree_ray(ray, 0, frame);
+        rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(rtc_scene, &context.embree, &rayhit);
+        return finish_hit(ray, rayhit.hit.instID[0], rayhit.hit.geomID, rayhit.hit.primID, context.best_t[0],
+                          context.best_normal[0], out, retry);
+    }
 
     /// Calls `lanes.operator()<W>(first)` for first = 0, W, 2W, ... < count, with W the native
     /// lane_width, so that each packet query is written once for every width. False when
@@ -854,10 +1072,8 @@ struct Accelerator::Impl {
             if (!valid[lane]) continue;
             bool retry = false;
             found[i] = finish_hit(rays[i], packet.hit.instID[0][lane], packet.hit.geomID[lane], packet.hit.primID[lane],
-                                  packet.hit.u[lane], packet.hit.v[lane], packet.ray.tfar[lane],
-                                  {packet.hit.Ng_x[lane], packet.hit.Ng_y[lane], packet.hit.Ng_z[lane]},
                                   context.best_t[i], context.best_normal[i], hits[i], retry);
-            if (retry) found[i] = intersect_beyond(rays[i], packet.ray.tfar[lane], hits[i]);
+            if (retry) found[i] = intersect_again(rays[i], hits[i]);
         }
     }
 
@@ -879,9 +1095,15 @@ struct Accelerator::Impl {
         return false;
     }
 
+    /// A shadow ray's triangle candidates are decided by the double test as Embree meets them
+    /// (triangle_filter): the first it accepts ends the search, so the filter is called about
+    /// once per blocked ray. With exact_range the meshes carry the filter themselves.
+    RTCFilterFunctionN shadow_filter() const { return frame.exact_range ? nullptr : triangle_filter; }
+
     bool occluded(const Ray& ray) const {
         if (occluded_by_plane(ray)) return true;
         QueryContext context(&ray, nullptr, 1, false);
+        context.embree.filter = shadow_filter();
         RTCRay r = make_embree_ray(ray, 0, frame);
         rtcOccluded1(rtc_scene, &context.embree, &r);
         return r.tfar < 0;
@@ -915,6 +1137,7 @@ struct Accelerator::Impl {
         bool query[packet_size];
         for (int i = 0; i < count; ++i) query[i] = active[i] && !(blocked[i] = occluded_by_plane(rays[i]));
         QueryContext context(rays, query, count, true);
+        context.embree.filter = shadow_filter();
         const bool traced = in_native_groups(
             count, [&]<int W>(int first) { occluded_lanes<W>(context, rays, query, first, count, blocked); });
         if (!traced)
