@@ -176,7 +176,8 @@ constexpr double triangle_edge_margin = 1e-10;
 /// the ray by up to 5e-3, past the shadow window) or passes within about 1e-9 of an edge
 /// (POV-Ray's float planes of two neighbours can leave a crack between them, or overlap): the
 /// instancing bench tori and the 1M-triangle anchor failed the strict rule at such pixels
-/// (docs/validation.md, "Mesh triangles"). POV-Ray's test needs the mesh as POV-Ray reads
+/// (docs/pov-model.md §3, "Mesh triangles"; docs/validation.md, "Grazing rays on the
+/// instancing bench tori"). POV-Ray's test needs the mesh as POV-Ray reads
 /// it; `whitted convert` writes a mesh whose coordinates reach 16 on some axis about a centre
 /// of its own (pov_writer.cpp, mesh_centre), and such a mesh, whose plane distances POV-Ray
 /// holds in that frame, is decided by the exact test (Möller–Trumbore in double).
@@ -224,9 +225,9 @@ bool hit_triangle_in_double(const TriangleMesh& mesh, unsigned prim, const Ray& 
 }
 
 /// Embree's filter for triangle candidates (hit_triangle_in_double): on the meshes' own
-/// geometry when every candidate must be decided as it is met (EmbreeFrame::exact_range, and
-/// shadow rays, whose first accepted candidate ends the search), otherwise on the context of
-/// a ray traced again after its nearest candidate was refused.
+/// geometry where every candidate must be decided as it is met (EmbreeFrame::exact_range);
+/// otherwise on the context of shadow rays (whose first accepted candidate ends the search)
+/// and of a ray traced again after its nearest candidate was refused.
 void triangle_filter(const RTCFilterFunctionNArguments* args) {
     const auto* geometry = static_cast<const TriangleGeometry*>(args->geometryUserPtr);
     const auto* context = reinterpret_cast<const QueryContext*>(args->context);
@@ -361,7 +362,7 @@ struct EmbreeFrame {
 
     /// The largest coordinate a ray or a finite shape has in this frame (the camera's included),
     /// and the diagonal of the box that holds them all, the longest distance a ray travels to a
-    /// shape: together they bound Embree's float error (Impl::triangle_margin).
+    /// shape: together they bound Embree's float error (Impl::world_triangle_margin).
     double reach = 0, span = 0;
 
     float t_min(const Ray& ray) const { return exact_range ? 0.0f : float(ray.t_min); }
@@ -488,7 +489,7 @@ Vec3 vertex_normal(const TriangleMesh& mesh, uint32_t index) {
 
 /// Whether a mesh is decided as POV-Ray decides it (decided_as_povray) and, if so, its vertex
 /// normals as POV-Ray holds them: made unit length again as they are read, then stored as
-/// floats (parse.cpp). Computed once here rather than at each hit (blended_normal).
+/// floats (POV-Ray's parse.cpp). Computed once here rather than at each hit (blended_normal).
 struct MeshAsPovray {
     bool decided = false;
     std::vector<float> normals;  ///< 3 per vertex; empty unless decided and the mesh has normals
