@@ -22,7 +22,6 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
-#include <sys/prctl.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -535,11 +534,8 @@ bool embree_isa_usable() {
 }  // namespace
 
 int main(int argc, char** argv) {
-    // Embree asks for transparent huge pages (madvise) for all its BVH memory. Here, faulting
-    // them in made the 1M-triangle build take 0.25-0.3 s in about every other run against
-    // 0.13-0.16 s with ordinary pages, and rendering was no faster with them
-    // (docs/performance.md). This turns them off for the process only.
-    prctl(PR_SET_THP_DISABLE, 1, 0, 0, 0);
+    // Transparent huge pages stay on: Embree asks for them for its BVH, and this program's
+    // operator new for every block of 2 MiB or more (huge_pages.cpp, docs/performance.md).
     CLI::App app{
         "Whitted: an offline ray tracer for the classic lecture shading model\n"
         "  L = ka*Ia + sum_i [kd*I_i*max(0,n.l_i) + ks*I_i*max(0,n.h_i)^p] + km*L(r)\n"
