@@ -4,10 +4,10 @@
 //
 // Why: a render touches most of its memory once, fresh from the kernel (the image, the mesh
 // arrays, the widened triangles, Embree's BVH), and the first touch of each page is a page
-// fault. With 4 KiB pages a 1M-triangle scene takes ~50,000 of them; on a virtual machine each
-// costs microseconds, and on the one Whitted is measured on they were half of the torus1m
-// anchor's whole-process time (docs/performance.md, "Huge pages"). One 2 MiB page replaces 512
-// faults. Most Debian kernels set transparent huge pages to "madvise", so a program has to ask,
+// fault. With 4 KiB pages the 1M-triangle anchor takes ~45,000 of them; on a virtual machine
+// each costs microseconds, and on the one Whitted is measured on huge pages took a third off
+// that anchor's whole-process time (docs/performance.md, "Huge pages"). One 2 MiB page
+// replaces 512 faults. Most Debian kernels set transparent huge pages to "madvise", so a program has to ask,
 // and glibc's malloc asks only when GLIBC_TUNABLES says so before the program starts.
 //
 // Only the program replaces operator new: the library (libwhitted, the Python module) leaves
