@@ -7,8 +7,9 @@
 // fault. With 4 KiB pages the 1M-triangle anchor takes ~45,000 of them; on a virtual machine
 // each costs microseconds, and on the one Whitted is measured on huge pages took a third off
 // that anchor's whole-process time (docs/performance.md, "Huge pages"). One 2 MiB page
-// replaces 512 faults. Most Debian kernels set transparent huge pages to "madvise", so a program has to ask,
-// and glibc's malloc asks only when GLIBC_TUNABLES says so before the program starts.
+// replaces 512 faults. Most Debian kernels set transparent huge pages to "madvise", so a
+// program has to ask, and glibc's malloc asks only when GLIBC_TUNABLES says so before the
+// program starts.
 //
 // Only the program replaces operator new: the library (libwhitted, the Python module) leaves
 // its host's allocator alone. Memory from here is plain malloc memory (aligned_alloc), so the
@@ -17,13 +18,7 @@
 // ThreadSanitizer nothing is replaced: their own operator new checks every new against its
 // delete.
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define WHITTED_SANITIZED_NEW 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-#define WHITTED_SANITIZED_NEW 1
-#endif
-#endif
+#include "huge_pages.h"
 
 #ifndef WHITTED_SANITIZED_NEW
 
@@ -35,7 +30,7 @@
 
 namespace {
 
-constexpr std::size_t huge_page = std::size_t(2) << 20;
+constexpr std::size_t huge_page = whitted::huge_page_bytes;
 
 /// `size` bytes, on a huge-page boundary with the huge pages asked for if there are 2 MiB or
 /// more of them; nullptr when out of memory.
