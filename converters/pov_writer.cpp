@@ -259,8 +259,9 @@ private:
 
     void mesh_file(const ObjectDescription& object, const Transform& to_world) {
         const bool msh = std::filesystem::path(object.file_path).extension() == ".msh";
+        // As validate_scene loads it: with the object's own material the MTL files are not read.
         const MeshData data = msh ? load_msh_mesh(object.file_path, object.file.where)
-                                  : load_obj_mesh(object.file_path, object.file.where);
+                                  : load_obj_mesh(object.file_path, object.file.where, 0, !object.material);
         std::vector<Vec3> vertices, normals;
         for (size_t i = 0; i < data.positions.size() / 3; ++i)
             vertices.push_back({data.positions[3 * i], data.positions[3 * i + 1], data.positions[3 * i + 2]});

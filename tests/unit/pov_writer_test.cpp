@@ -325,6 +325,26 @@ TEST(PovWriter, TintedSpecularAloneSelectsRecipeB) {
     EXPECT_EQ(numbers_after(sdl, "rgbf", 4), (std::vector<double>{0.5 / 0.25, 0.5 / 0.25, 0.25 / 0.25, 1}));
 }
 
+// A mesh file whose object gives its own material is converted as it is rendered
+// (validate_scene): its MTL side is not read, so a `usemtl` of nothing, or faces without one,
+// neither warn of a default material it does not get nor stop the conversion.
+TEST(PovWriter, MeshWithItsOwnMaterialIgnoresTheObjMaterialsAsRenderDoes) {
+    const test::ScratchDirectory dir;
+    dir.write("tri.obj", "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl nowhere\nf 1 2 3\nf 3 2 1\n");
+    const std::string scene = (dir.path() / "scene.yaml").string();
+    const std::string objects = "objects:\n  - {type: mesh, file: tri.obj, material: {kd: [0.25, 0.5, 0.75]}}\n";
+    (void)test::scene_from("camera: {eye: [0, 1, 5], look_at: [0, 0, 0]}\nimage: {width: 4, height: 3}\n" + objects,
+                           scene);  // render accepts it
+    ::testing::internal::CaptureStderr();
+    std::string sdl;
+    EXPECT_NO_THROW(sdl = sdl_for(objects, scene));
+    const std::string printed = ::testing::internal::GetCapturedStderr();
+    EXPECT_THAT(printed, Not(HasSubstr("default material")));
+    EXPECT_THAT(printed, Not(HasSubstr("warning")));
+    EXPECT_EQ(count_of(sdl, "mesh2"), 1u);
+    EXPECT_EQ(numbers_after(sdl, "pigment { rgb", 3), (std::vector<double>{0.25, 0.5, 0.75}));
+}
+
 // The .ini renders deterministically and linearly (docs/pov-model.md §0): size, no display, no
 // antialiasing, 16-bit linear PNG.
 TEST(PovWriter, IniIsLinearAndDeterministic) {
