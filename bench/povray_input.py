@@ -11,7 +11,9 @@ make POV-Ray's answer exact but cost it time.
   written bare again.
 
 A speed comparison must give POV-Ray its fastest setting, so the benchmarks time POV-Ray's
-default mesh2 and bare boxes; the images column then shows the few pixels where those differ."""
+default mesh2 and bare boxes. bench/run.py compares Whitted's images with POV-Ray's render of the
+exact SDL (made once more, untimed); bench/scaling.py's images column shows the few pixels where
+the fastest input differs."""
 import re
 import subprocess
 from pathlib import Path
@@ -30,7 +32,11 @@ def fastest_sdl(text: str) -> str:
     return "".join(out)
 
 
-def convert_for_timing(whitted: str, scene: Path, pov: Path) -> None:
-    """Writes pov (and its .ini) from scene with `whitted convert`, then makes it fastest_sdl."""
+def convert_for_timing(whitted: str, scene: Path, pov: Path) -> bool:
+    """Writes pov (and its .ini) from scene with `whitted convert`, then makes it fastest_sdl.
+    True when that changed the SDL (POV-Ray's image of it may then differ in a few pixels)."""
     subprocess.run([whitted, "convert", str(scene), str(pov)], check=True, stderr=subprocess.DEVNULL)
-    pov.write_text(fastest_sdl(pov.read_text()))
+    exact = pov.read_text()
+    fast = fastest_sdl(exact)
+    pov.write_text(fast)
+    return fast != exact
