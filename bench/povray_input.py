@@ -32,11 +32,14 @@ def fastest_sdl(text: str) -> str:
     return "".join(out)
 
 
-def convert_for_timing(whitted: str, scene: Path, pov: Path) -> bool:
+def convert_for_timing(whitted: str, scene: Path, pov: Path, exact_pov: Path | None = None) -> bool:
     """Writes pov (and its .ini) from scene with `whitted convert`, then makes it fastest_sdl.
-    True when that changed the SDL (POV-Ray's image of it may then differ in a few pixels)."""
+    True when that changed the SDL (POV-Ray's image of it may then differ in a few pixels); the
+    SDL as converted is then kept in exact_pov, where given."""
     subprocess.run([whitted, "convert", str(scene), str(pov)], check=True, stderr=subprocess.DEVNULL)
     exact = pov.read_text()
     fast = fastest_sdl(exact)
     pov.write_text(fast)
+    if fast != exact and exact_pov is not None:
+        exact_pov.write_text(exact)
     return fast != exact
