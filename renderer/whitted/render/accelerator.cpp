@@ -673,12 +673,16 @@ struct Accelerator::Impl {
     /// single frame cannot win back. On the 1M-triangle anchor (2 threads, 1280x960) LOW built
     /// in 0.06 s against 0.15 s and rendered 0.02 s (10 %) slower; on the 100k-triangle one the
     /// two came out even, and on the 100 spheres LOW rendered 15-25 % slower (docs/performance.md).
-    /// So LOW once the triangles outnumber a quarter of the camera rays. The BVH only changes
-    /// the order in which candidates are met: the 1M-triangle image came out bit-identical.
+    /// So LOW once the triangles outnumber a quarter of the camera rays. Spheres and boxes count
+    /// half: a candidate costs more to test there (a callback in double), so a poorer BVH costs
+    /// more per ray; at 640x480, LOW saved 0.2 s of 0.48 s building a million spheres (or boxes)
+    /// and cost 0.03 s of render, while at 100k the two came out even. The BVH only changes the
+    /// order in which candidates are met: those images came out bit-identical.
     RTCBuildQuality build_quality() const {
-        const size_t triangles = scene.triangle_count();
+        const double primitives =
+            double(scene.triangle_count()) + 0.5 * double(scene.spheres.size() + scene.boxes.size());
         const double camera_rays = double(scene.width) * scene.height * scene.samples * scene.samples;
-        return double(triangles) > camera_rays / 4 ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM;
+        return primitives > camera_rays / 4 ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM;
     }
 
     /// The frame: centred on the bounds of the scene's finite shapes when they lie further from
