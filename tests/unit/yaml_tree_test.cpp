@@ -237,3 +237,93 @@ TEST(ParseMessages, ControlCharactersInANameAreEscaped) {
 
 }  // namespace
 }  // namespace whitted
+
+// Large scene files are let go of behind the reader (MappedTextFile::reader_at), so that the file
+// does not add its size to the peak memory; what is read must not change.
+namespace whitted {
+namespace {
+
+/// The process's resident pages of mapped files, in KiB (/proc/self/status, RssFile).
+long resident_file_kib() {
+    std::ifstream status("/proc/self/status");
+    std::string line;
+    while (std::getline(status, line))
+        if (line.rfind("RssFile:", 0) == 0) return std::stol(line.substr(8));
+    ADD_FAILURE() << "no RssFile in /proc/self/status";
+    return -1;
+}
+
+/// A scene of `spheres` one-line spheres, each at its own place (so that a wrong byte shows).
+std::string many_spheres(int spheres) {
+    std::string text =
+        "image: { width: 64, height: 48 }\ncamera: { eye: [0, 6, 14], look_at: [0, 0, 0] }\n"
+        "materials:\n  ball: { kd: 0.5 }\nobjects:\n";
+    for (int i = 0; i < spheres; ++i)
+        text += "  - { type: sphere, center: [" + std::to_string(i % 1000) + ".25, " + std::to_string(i / 1000) +
+                ".5, -" + std::to_string(i) + "], radius: 0.125, material: ball }\n";
+    return text;
+}
+
+TEST(MappedTextFile, PagesLetGoLeaveTheProcessButTheTextStaysTheSame) {
+    const test::ScratchDirectory dir;
+    std::string bytes(size_t(24) << 20, '\0');
+    for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = char('a' + (i * 7919 % 26));
+    const std::string path = dir.write("big.txt", bytes);
+    MappedTextFile file(path, int64_t(1) << 30, "test file");
+    ASSERT_EQ(file.text(), bytes);  // every page read, so resident
+    const long before = resident_file_kib();
+    file.reader_at(file.text().size());  // done with all of it
+    const long after = resident_file_kib();
+    EXPECT_GE(before - after, 20 * 1024) << "RssFile " << before << " KiB -> " << after << " KiB";
+    EXPECT_EQ(file.text(), bytes);  // read again: the same bytes, from the page cache
+    // A reader going through again from the start is told of smaller offsets: it lets go again.
+    file.reader_at(0);
+    file.reader_at(file.text().size());
+    EXPECT_LE(resident_file_kib(), after + 4 * 1024);
+    EXPECT_EQ(file.text(), bytes);
+}
+
+TEST(YamlTree, TheFastScannerSaysWhereItIsAsItGoes) {
+    const std::string text = many_spheres(250000);  // about 20 MB
+    ASSERT_GT(text.size(), 2 * MappedTextFile::reader_stride);
+    for (const yaml_tree::Reader reader : {yaml_tree::Reader::fast, yaml_tree::Reader::libyaml}) {
+        std::vector<size_t> told;
+        yaml_tree::Document document;
+        size_t objects = 0;
+        document.read(
+            text, "many.yaml", [&](const yaml_tree::Node&, size_t) { ++objects; }, {}, &reader,
+            [&](size_t offset) { told.push_back(offset); });
+        EXPECT_EQ(objects, 250000u);
+        if (reader == yaml_tree::Reader::libyaml) {
+            EXPECT_TRUE(told.empty());  // libyaml's own buffers: nothing to say
+            continue;
+        }
+        ASSERT_GE(told.size(), 3u);
+        EXPECT_EQ(told.front(), 0u);
+        for (size_t i = 1; i < told.size(); ++i) {
+            EXPECT_GE(told[i] - told[i - 1], MappedTextFile::reader_stride);
+            EXPECT_LT(told[i], text.size());
+        }
+    }
+}
+
+TEST(Load, ALargeSceneFileGivesTheSceneItsTextGives) {
+    const test::ScratchDirectory dir;
+    const std::string text = many_spheres(250000);
+    const std::string path = dir.write("many.yaml", text);
+    for (const bool one_pass : {false, true}) {
+        const Scene from_file = one_pass ? load_scene_file(path) : validate_scene(parse_scene_file(path));
+        const Scene from_text = one_pass ? load_scene_text(text, path) : validate_scene(parse_scene_text(text, path));
+        ASSERT_EQ(from_file.spheres.size(), 250000u);
+        ASSERT_EQ(from_text.spheres.size(), 250000u);
+        for (size_t i = 0; i < from_file.spheres.size(); i += 997) {
+            EXPECT_EQ(from_file.spheres[i].center.x, from_text.spheres[i].center.x);
+            EXPECT_EQ(from_file.spheres[i].center.z, from_text.spheres[i].center.z);
+            EXPECT_EQ(from_file.spheres[i].center.z, -double(i));
+        }
+        EXPECT_EQ(from_file.spheres.back().center.y, from_text.spheres.back().center.y);
+    }
+}
+
+}  // namespace
+}  // namespace whitted

@@ -674,12 +674,16 @@ const char* to_string(ObjectType type) {
     return "object";
 }
 
-SceneDescription parse_scene_text(std::string_view text, const std::string& path, const ObjectSink* sink) {
+namespace {
+
+/// parse_scene_text, telling `done_before` (if given) how far through the text it is.
+SceneDescription parse_text(std::string_view text, const std::string& path, const ObjectSink* sink,
+                            const DoneBefore& done_before) {
     ParseContext ctx;
     ctx.sink = sink;
     ctx.file = path;
     ctx.directory = std::filesystem::path(path).parent_path().string();
-    check_text_is_readable(text, path);
+    check_text_is_readable(text, path, done_before);
     yaml_tree::Document document;
     // Room for as many objects as a file of one-line objects holds (a sphere takes 64 bytes of
     // text at least): moving hundreds of thousands of descriptions each time the list grows cost
@@ -706,8 +710,14 @@ SceneDescription parse_scene_text(std::string_view text, const std::string& path
     };
     yaml_tree::Limits tree_limits;
     tree_limits.max_nodes_at_once = tree_limits.max_alias_values = uint64_t(limits::max_yaml_nodes);
-    document.read(text, ctx.file, on_object, tree_limits);
+    document.read(text, ctx.file, on_object, tree_limits, nullptr, done_before);
     return parse_document(ctx, document.root());
+}
+
+}  // namespace
+
+SceneDescription parse_scene_text(std::string_view text, const std::string& path, const ObjectSink* sink) {
+    return parse_text(text, path, sink, {});
 }
 
 SceneDescription parse_scene_file(const std::string& path, const ObjectSink* sink) {
@@ -721,8 +731,11 @@ SceneDescription parse_scene_file(const std::string& path, const ObjectSink* sin
     }  // the Cornell course's XML scenes
     // Mapped, not copied; devices, fifos and other files that are not regular files are refused
     // before a byte is read (/dev/urandom would never end).
-    const MappedTextFile file(path, limits::max_scene_file_bytes, "scene file");
-    return parse_scene_text(file.text(), path, sink);
+    // The text is gone through once (or twice, where libyaml reads it again), and nothing read
+    // from it points back into it: the pages behind the reader are let go as it goes, so that a
+    // large scene file does not add its size to the peak memory.
+    MappedTextFile file(path, limits::max_scene_file_bytes, "scene file");
+    return parse_text(file.text(), path, sink, [&file](size_t offset) { file.reader_at(offset); });
 }
 
 }  // namespace whitted

@@ -38,9 +38,16 @@ bool is_plain_ascii(std::string_view text) {
     return true;
 }
 
-void check_text_is_readable(std::string_view text, const std::string& path) {
-    // Only text with something other than plain ASCII in it is looked at byte by byte.
-    if (is_plain_ascii(text)) return;
+void check_text_is_readable(std::string_view text, const std::string& path, const DoneBefore& done_before) {
+    // Only text with something other than plain ASCII in it is looked at byte by byte. In parts,
+    // so that each can be let go once checked; the scanner brings the pages back as it reads.
+    constexpr size_t part = MappedTextFile::reader_stride;
+    bool plain = true;
+    for (size_t begin = 0; begin < text.size() && plain; begin += part) {
+        if (done_before) done_before(begin);
+        plain = is_plain_ascii(text.substr(begin, part));
+    }
+    if (plain) return;
     const auto* bytes = reinterpret_cast<const unsigned char*>(text.data());
     const size_t n = text.size();
     int line = 1, column = 1;
@@ -129,10 +136,26 @@ MappedTextFile::MappedTextFile(const std::string& path, int64_t max_bytes, const
             ::close(fd);
             throw InputError({path}, "cannot read the " + what + ": " + std::strerror(mmap_errno));
         }
-        ::madvise(m_address, m_length, MADV_SEQUENTIAL | MADV_WILLNEED);
+        ::madvise(m_address, m_length, MADV_WILLNEED);  // read ahead (the kernel's page cache)
         m_text = std::string_view(static_cast<const char*>(m_address), m_length);
     }
     ::close(fd);
+}
+
+void MappedTextFile::reader_at(size_t offset) {
+    static const size_t page = size_t(::sysconf(_SC_PAGESIZE));
+    if (!m_address) return;
+    offset = std::min(offset, m_length);
+    const size_t behind = offset / page * page;
+    if (behind < m_let_go) m_let_go = 0;  // a reader going through again (the scanner after the check)
+    // A private, read-only file mapping never written: MADV_DONTNEED drops the page table
+    // entries only, and a later read faults the same bytes back in from the page cache.
+    if (behind > m_let_go) ::madvise(static_cast<char*>(m_address) + m_let_go, behind - m_let_go, MADV_DONTNEED);
+    m_let_go = behind;
+    // The part ahead, mapped in one call (Linux 5.14 on; older kernels refuse the advice and
+    // the reader's page faults do it, as they did before).
+    const size_t ahead_end = std::min(m_length, behind + reader_stride + page);
+    if (ahead_end > behind) ::madvise(static_cast<char*>(m_address) + behind, ahead_end - behind, MADV_POPULATE_READ);
 }
 
 MappedTextFile::~MappedTextFile() {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -16,9 +17,14 @@ std::string read_text_file(const std::string& path, int64_t max_bytes, const std
 /// True when every byte is ASCII and none is NUL: such text needs no closer look.
 bool is_plain_ascii(std::string_view text);
 
+/// Told an offset into a text by a reader that goes through it once: the reader is done with
+/// what lies before it and about to read what follows (MappedTextFile::reader_at).
+using DoneBefore = std::function<void(size_t offset)>;
+
 /// Refuses text a YAML parser should never see: NUL bytes (binary files) and invalid UTF-8,
-/// reported at the line and column of the first bad byte.
-void check_text_is_readable(std::string_view text, const std::string& path);
+/// reported at the line and column of the first bad byte. `done_before`, if given, is told where
+/// the check is, every MappedTextFile::reader_stride bytes of plain ASCII text.
+void check_text_is_readable(std::string_view text, const std::string& path, const DoneBefore& done_before = {});
 
 /// A file mapped into memory, read-only (mesh files are tens of megabytes: no copy, no zeroed
 /// buffer). Throws InputError like read_text_file.
@@ -29,11 +35,22 @@ public:
     MappedTextFile(const MappedTextFile&) = delete;
     MappedTextFile& operator=(const MappedTextFile&) = delete;
     std::string_view text() const { return m_text; }
+    /// A reader going through the text once is at `offset`: the whole pages before it leave
+    /// this process's memory, and the next `reader_stride` bytes are mapped in, in one call
+    /// rather than a page fault every few pages. The text stays the same: the pages let go are
+    /// still in the kernel's page cache and come back from there if read again. So a large
+    /// file does not add its whole size to the peak memory (a million spheres written as
+    /// indented JSON take 157 MB). An offset smaller than the one before means that a reader is
+    /// going through the text again (the scanner, after the UTF-8 check).
+    void reader_at(size_t offset);
+    /// How far apart a reader's reader_at calls should be.
+    static constexpr size_t reader_stride = size_t(8) << 20;
 
 private:
     std::string_view m_text;
     void* m_address = nullptr;
     size_t m_length = 0;
+    size_t m_let_go = 0;  ///< bytes from the start let go by the latest reader (whole pages)
 };
 
 /// `text` made safe to print in a message: control characters (ESC, BEL, ...) written as \xNN

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "whitted/scene/yaml_tree.h"
 
+#include "whitted/scene/text_checks.h"
+
 #include <yaml.h>
 
 #include <algorithm>
@@ -364,9 +366,11 @@ namespace {
 
 class FastScanner {
 public:
-    FastScanner(std::string_view text, Builder& builder) : m_text(text), m_builder(builder) {}
+    FastScanner(std::string_view text, Builder& builder, const std::function<void(size_t)>& done_before)
+        : m_text(text), m_builder(builder), m_done_before(done_before) {}
 
     void read() {
+        if (m_done_before) m_done_before(0);
         skip_blank_lines();
         if (at_end()) return;  // no document at all
         m_builder.document_start(line(), column());
@@ -385,6 +389,19 @@ public:
 
 private:
     [[noreturn]] static void give_up() { throw NotForTheFastScanner(); }
+
+    /// A map or list ends: every `done_every` bytes, the reader is told that the text before
+    /// here is done with. (It is not read again, but if it were, a mapped file's bytes would
+    /// come back the same: MappedTextFile::reader_at.) By position, not by line: a JSON file
+    /// may be one line.
+    void end() {
+        m_builder.end();
+        if (m_done_before && m_p >= m_next_done) {
+            m_done_before(m_p);
+            m_next_done = m_p + done_every;
+        }
+    }
+    static constexpr size_t done_every = MappedTextFile::reader_stride;
 
     bool at_end() const { return m_p >= m_text.size(); }
     char peek(size_t ahead = 0) const { return m_p + ahead < m_text.size() ? m_text[m_p + ahead] : '\0'; }
@@ -518,7 +535,7 @@ private:
             skip_flow_space();
             if (peek() == '}') {
                 ++m_p;
-                return m_builder.end();
+                return end();
             }
             for (;;) {
                 std::string_view key;
@@ -541,7 +558,7 @@ private:
                 }
                 if (peek() != '}') give_up();
                 ++m_p;
-                return m_builder.end();
+                return end();
             }
         }
         if (first == '[') {
@@ -550,7 +567,7 @@ private:
             skip_flow_space();
             if (peek() == ']') {
                 ++m_p;
-                return m_builder.end();
+                return end();
             }
             for (;;) {
                 flow_value();
@@ -563,7 +580,7 @@ private:
                 }
                 if (peek() != ']') give_up();
                 ++m_p;
-                return m_builder.end();
+                return end();
             }
         }
         std::string_view value;
@@ -652,7 +669,7 @@ private:
             if (next > indent) give_up();
             if (peek() == '-' && blank_or_end(1)) give_up();
         }
-        m_builder.end();
+        end();
     }
 
     void block_sequence(uint32_t indent) {
@@ -674,11 +691,13 @@ private:
             if (next > indent) give_up();
             if (!(peek() == '-' && blank_or_end(1))) break;  // the next key of a map at this indentation
         }
-        m_builder.end();
+        end();
     }
 
     std::string_view m_text;
     Builder& m_builder;
+    const std::function<void(size_t)>& m_done_before;
+    size_t m_next_done = done_every;
     size_t m_p = 0;
     size_t m_line_start = 0;
     uint32_t m_line = 1;
@@ -687,12 +706,12 @@ private:
 
 }  // namespace
 
-void read_fast(std::string_view text, Builder& builder) {
-    FastScanner(text, builder).read();
+void read_fast(std::string_view text, Builder& builder, const std::function<void(size_t)>& done_before) {
+    FastScanner(text, builder, done_before).read();
 }
 
 void Document::read(std::string_view text, FileName file, const ObjectCallback& on_object, const Limits& limits,
-                    const Reader* force) {
+                    const Reader* force, const std::function<void(size_t)>& done_before) {
     m_file = file;
     const auto attempt = [&](Reader reader) {
         m_nodes.clear(), m_children.clear(), m_arena.clear();
@@ -700,7 +719,7 @@ void Document::read(std::string_view text, FileName file, const ObjectCallback& 
         m_reader = reader;
         Builder builder(*this, on_object, limits);
         if (reader == Reader::fast)
-            read_fast(text, builder);
+            read_fast(text, builder, done_before);
         else
             read_with_libyaml(text, builder);
         m_root = builder.root();

@@ -131,8 +131,10 @@ public:
     /// file's line and column for a syntax error, a second document or a limit passed.
     /// `force` chooses the reader (tests compare the two); by default the fast scanner, and
     /// libyaml where the scanner stops.
+    /// `done_before`, if given, is told where the fast scanner is: at the start, then every
+    /// MappedTextFile::reader_stride bytes or so (MappedTextFile::reader_at).
     void read(std::string_view text, FileName file, const ObjectCallback& on_object = {}, const Limits& limits = {},
-              const Reader* force = nullptr);
+              const Reader* force = nullptr, const std::function<void(size_t)>& done_before = {});
 
     /// The document's top value (undefined for an empty stream, null for an empty document).
     Node root() const { return m_root == UINT32_MAX ? Node() : Node(this, m_root); }
