@@ -142,10 +142,21 @@ public:
                         return true;
                 return false;
             };
+        // Whether an instance without a material of its own places it: only then do the
+        // defaults of its OBJ files show (and their warnings say something true).
+        std::function<bool(const std::vector<ObjectDescription>&, const std::string&)> shows_defaults =
+            [&](const auto& list, const std::string& name) {
+                for (const auto& object : list)
+                    if ((object.type == ObjectType::instance && object.prototype.value == name && !object.material) ||
+                        shows_defaults(object.children, name))
+                        return true;
+                return false;
+            };
         for (size_t i = 0; i < prototypes.size(); ++i) {
             if (!places(m_description.objects, prototypes[i].name)) continue;
             m_out += "// prototype " + comment_safe(prototypes[i].name) + "\n";
             m_collect = &m_pieces[i];
+            m_collect_shows_defaults = shows_defaults(m_description.objects, prototypes[i].name);
             write(prototypes[i].object, Transform());
             m_collect = nullptr;
             for (size_t k = 0; k < m_pieces[i].size(); ++k) {
@@ -262,6 +273,7 @@ private:
         // As validate_scene loads it: with the object's own material the MTL files are not read.
         const MeshData data = msh ? load_msh_mesh(object.file_path, object.file.where)
                                   : load_obj_mesh(object.file_path, object.file.where, 0, !object.material);
+        if (!m_collect || m_collect_shows_defaults) print_mesh_warnings(data);
         std::vector<Vec3> vertices, normals;
         for (size_t i = 0; i < data.positions.size() / 3; ++i)
             vertices.push_back({data.positions[3 * i], data.positions[3 * i + 1], data.positions[3 * i + 2]});
@@ -357,6 +369,7 @@ private:
     std::map<std::string, Material> m_named;
     std::vector<std::vector<Piece>> m_pieces;  ///< per prototype: its declared mesh2s
     std::vector<Piece>* m_collect = nullptr;   ///< the prototype being declared, or null
+    bool m_collect_shows_defaults = false;     ///< an instance without a material places it
 };
 
 double max_channel(const Color& c) {

@@ -345,6 +345,38 @@ TEST(PovWriter, MeshWithItsOwnMaterialIgnoresTheObjMaterialsAsRenderDoes) {
     EXPECT_EQ(numbers_after(sdl, "pigment { rgb", 3), (std::vector<double>{0.25, 0.5, 0.75}));
 }
 
+// A prototype's OBJ without usemtl: its faces get the default material only through an
+// instance without a material of its own, so render and convert warn of it only then (with
+// every instance giving one, the warning used to name a material nothing is drawn with).
+TEST(PovWriter, TheDefaultMaterialIsWarnedOfOnlyWhereAnInstanceShowsIt) {
+    const test::ScratchDirectory dir;
+    dir.write("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    const std::string scene = (dir.path() / "scene.yaml").string();
+    const std::string head = "camera: {eye: [0, 1, 5], look_at: [0, 0, 0]}\nimage: {width: 4, height: 3}\n";
+    const std::string prototypes = "prototypes:\n  tri: {type: mesh, file: tri.obj}\n";
+    const std::string given = "  - {type: instance, prototype: tri, material: {kd: 0.5}}\n";
+    const std::string left = "  - {type: instance, prototype: tri, transform: {translate: [1, 0, 0]}}\n";
+    for (const std::string& objects : {given, given + given, given + left, left}) {
+        const std::string text = prototypes + "objects:\n" + objects;
+        const bool shows = objects.find("transform") != std::string::npos;
+        const SceneDescription d = parse_scene_text(head + text, scene);
+        for (const int reader : {0, 1, 2}) {  // render's one pass, the two passes, convert alone
+            ::testing::internal::CaptureStderr();
+            if (reader == 0) (void)load_scene_text(head + text, scene);
+            if (reader == 1) (void)validate_scene(d);
+            if (reader == 2) (void)pov::scene_to_sdl(d);
+            const std::string printed = ::testing::internal::GetCapturedStderr();
+            EXPECT_EQ(count_of(printed, "they get the default material"), shows ? 1u : 0u)
+                << "reader " << reader << ", objects:\n"
+                << objects << "printed: " << printed;
+        }
+    }
+    // A plain mesh without a material shows it, and says so.
+    ::testing::internal::CaptureStderr();
+    (void)test::scene_from(head + "objects:\n  - {type: mesh, file: tri.obj}\n", scene);
+    EXPECT_THAT(::testing::internal::GetCapturedStderr(), HasSubstr("they get the default material"));
+}
+
 // The .ini renders deterministically and linearly (docs/pov-model.md §0): size, no display, no
 // antialiasing, 16-bit linear PNG.
 TEST(PovWriter, IniIsLinearAndDeterministic) {

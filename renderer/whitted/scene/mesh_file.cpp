@@ -1133,8 +1133,11 @@ MeshData load_obj_mesh(const std::string& path, const SourceLocation& referenced
     } else {
         std::fill(mesh.triangle_material.begin(), mesh.triangle_material.end(), -1);
     }
-    for (const std::string& warning : mesh.warnings) std::fprintf(stderr, "whitted: warning: %s\n", warning.c_str());
     return std::move(mesh);
+}
+
+void print_mesh_warnings(const MeshData& mesh) {
+    for (const std::string& warning : mesh.warnings) std::fprintf(stderr, "whitted: warning: %s\n", warning.c_str());
 }
 
 }  // namespace whitted

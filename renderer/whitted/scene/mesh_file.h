@@ -19,9 +19,13 @@ struct MeshData {
     std::vector<int32_t> triangle_material;      ///< index into materials per triangle, −1 = none
     std::vector<MaterialDescription> materials;  ///< from the MTL: Ka→ka, Kd→kd, Ks→ks, Ns→p, illum 3→km=Ks
     /// What the loader did that the file did not ask for (faces given the default material),
-    /// each "FILE:LINE:COL: text"; load_obj_mesh also prints them to stderr.
+    /// each "FILE:LINE:COL: text". The caller prints them (print_mesh_warnings) where they say
+    /// something true of the render: not for a prototype whose every instance gives a material.
     std::vector<std::string> warnings;
 };
+
+/// Writes each of `mesh.warnings` to stderr as "whitted: warning: ...".
+void print_mesh_warnings(const MeshData& mesh);
 
 /// The name MeshData::materials gives the material of faces that have none (docs/scene-format.md
 /// §3.6): Kd 0.6 grey, nothing else, as an MTL material with only `Kd 0.6 0.6 0.6`.

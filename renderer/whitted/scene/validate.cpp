@@ -158,6 +158,12 @@ private:
             Prototype prototype;
             prototype.name = d.name;
             m_prototype = &prototype;
+            // The defaults its OBJ files give (and warn of) show only through an instance
+            // without a material of its own.
+            m_prototype_shows_defaults = false;
+            for (const PendingInstance& pending : m_pending_instances)
+                if (pending.prototype.value == d.name && pending.material == Instance::no_material)
+                    m_prototype_shows_defaults = true;
             add_object(d.object, Transform());
             m_prototype = nullptr;
             if (prototype.meshes.empty())
@@ -379,6 +385,7 @@ private:
             if (e.where().file == object.file.where.file) throw;
             throw with_reference(e);
         }
+        if (!m_prototype || m_prototype_shows_defaults) print_mesh_warnings(data);
         TriangleMesh mesh;
         if (object.material) {
             mesh.material = resolve_material(object);
@@ -478,6 +485,8 @@ private:
     }
 
     Scene& m_scene;
+    /// Whether some instance places the prototype being added without a material (add_prototypes).
+    bool m_prototype_shows_defaults = false;
     std::vector<NameUse> m_uses;  ///< material names in order of first use
     std::unordered_map<std::string, uint32_t> m_use_index;
     uint32_t m_last_use = UINT32_MAX;
