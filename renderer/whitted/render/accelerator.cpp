@@ -971,10 +971,15 @@ struct Accelerator::Impl {
             t_max = hit.t;
             found = true;
         }
+        // A plane takes an exact tie with the shape found (the bottom of a box standing on the
+        // floor, met by a ray inside another box that overlaps it): POV-Ray, which the
+        // cross-check compares with, meets its infinite objects first and keeps the first of
+        // equal depths. Among the planes the first one keeps it.
+        double plane_t_max = found ? std::nextafter(t_max, std::numeric_limits<double>::infinity()) : t_max;
         for (const Plane& plane : scene.planes) {
             ShapeHit plane_hit;
-            if (intersect_plane(plane, ray, ray.t_min, t_max, plane_hit)) {
-                t_max = plane_hit.t;
+            if (intersect_plane(plane, ray, ray.t_min, plane_t_max, plane_hit)) {
+                t_max = plane_t_max = plane_hit.t;
                 out.t = plane_hit.t;
                 out.normal = out.geometric_normal = plane.normal;
                 out.material = plane.material;
