@@ -6,11 +6,10 @@ overlapping, 400x300 with 2x2 samples, two lights, mirror materials, max depth 3
 unlike bench/generate.py (other shapes, transforms, JSON with indentation) as a check of scenes
 made elsewhere. At its pixel (254, 237) a mirror ray starts 4e-5 above a turned box's top
 (nearer than the 1e-4 a ray must travel), crosses that box and leaves it through its bottom, in
-the floor's plane: `whitted render` gave that bottom the tie and `whitted check` (the same scene
-read in two passes) the floor, as POV-Ray does, 1,147 codes apart. A plane now takes such a tie
-(accelerator.cpp, finish_hit), and ctest compares the two renders bit for bit. Coordinates keep
-7 decimals: with 3, overlapping boxes share faces, which the two renderers may give to either
-box (docs/validation.md, Known differences).
+the floor's plane: Whitted gave that bottom the hit and POV-Ray the floor, 1,147 codes apart,
+until a plane took such a tie (accelerator.cpp, finish_hit). Coordinates keep 7 decimals: with
+3, overlapping boxes share faces, which the two renderers may give to either box
+(docs/validation.md, Known differences).
 Usage: random_boxes.py OUT_DIR [N] [SEED]"""
 import json
 import random
