@@ -971,10 +971,10 @@ struct Accelerator::Impl {
             t_max = hit.t;
             found = true;
         }
-        // A plane takes an exact tie with the shape found (the bottom of a box standing on the
-        // floor, met by a ray inside another box that overlaps it): POV-Ray, which the
-        // cross-check compares with, meets its infinite objects first and keeps the first of
-        // equal depths. Among the planes the first one keeps it.
+        // A plane takes a tie (within an ulp) with the shape found: the bottom of a box standing
+        // on the floor, met by a ray inside the box. POV-Ray, which the cross-check compares
+        // with, shows the plane there (docs/pov-model.md §3, "A plane keeps a tie"). Among the
+        // planes the first one keeps it.
         double plane_t_max = found ? std::nextafter(t_max, std::numeric_limits<double>::infinity()) : t_max;
         for (const Plane& plane : scene.planes) {
             ShapeHit plane_hit;
