@@ -134,29 +134,23 @@ public:
     void prototype_declarations() {
         const auto& prototypes = m_description.prototypes;
         m_pieces.assign(prototypes.size(), {});
-        std::function<bool(const std::vector<ObjectDescription>&, const std::string&)> places =
-            [&](const auto& list, const std::string& name) {
+        // Whether an instance in `list` (or in its groups) places prototype `name`; with
+        // `without_material`, one that gives no material of its own: only then do the defaults
+        // of the prototype's OBJ files show (and their warnings say something true).
+        std::function<bool(const std::vector<ObjectDescription>&, const std::string&, bool)> places =
+            [&](const auto& list, const std::string& name, bool without_material) {
                 for (const auto& object : list)
-                    if ((object.type == ObjectType::instance && object.prototype.value == name) ||
-                        places(object.children, name))
-                        return true;
-                return false;
-            };
-        // Whether an instance without a material of its own places it: only then do the
-        // defaults of its OBJ files show (and their warnings say something true).
-        std::function<bool(const std::vector<ObjectDescription>&, const std::string&)> shows_defaults =
-            [&](const auto& list, const std::string& name) {
-                for (const auto& object : list)
-                    if ((object.type == ObjectType::instance && object.prototype.value == name && !object.material) ||
-                        shows_defaults(object.children, name))
+                    if ((object.type == ObjectType::instance && object.prototype.value == name &&
+                         !(without_material && object.material)) ||
+                        places(object.children, name, without_material))
                         return true;
                 return false;
             };
         for (size_t i = 0; i < prototypes.size(); ++i) {
-            if (!places(m_description.objects, prototypes[i].name)) continue;
+            if (!places(m_description.objects, prototypes[i].name, false)) continue;
             m_out += "// prototype " + comment_safe(prototypes[i].name) + "\n";
             m_collect = &m_pieces[i];
-            m_collect_shows_defaults = shows_defaults(m_description.objects, prototypes[i].name);
+            m_collect_shows_defaults = places(m_description.objects, prototypes[i].name, true);
             write(prototypes[i].object, Transform());
             m_collect = nullptr;
             for (size_t k = 0; k < m_pieces[i].size(); ++k) {
