@@ -264,6 +264,10 @@ Vec3 mesh2_smooth_normal(const Vec3& p1_in, const Vec3& p2_in, const Vec3& p3_in
 }
 
 void world_bounds(const Transform& to_world, const Vec3& lo, const Vec3& hi, Vec3& out_lo, Vec3& out_hi) {
+    if (to_world.is_identity()) {
+        out_lo = lo, out_hi = hi;
+        return;
+    }
     constexpr double inf = std::numeric_limits<double>::infinity();
     out_lo = Vec3(inf);
     out_hi = Vec3(-inf);
