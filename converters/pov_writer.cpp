@@ -12,6 +12,7 @@
 #include "whitted/core/ray.h"
 #include "whitted/geometry/shapes.h"
 #include "whitted/output/atomic_files.h"
+#include "whitted/render/povray_order.h"
 #include "whitted/scene/mesh_file.h"
 #include "whitted/scene/msh_file.h"
 #include "whitted/scene/scene.h"
@@ -249,17 +250,15 @@ private:
     /// the cut is 0.0078 wide). A union's bounding box holds those of its children, so two
     /// spheres of radius 0 (which no ray hits: POV-Ray's test needs a half chord² > 1e-10) at
     /// the corners of the box's world bounds, pushed out by 8 to 16 floats' spacing, make the
-    /// union's box hold the whole box. `split_union off` keeps POV-Ray from replacing the union
-    /// by its children; a union tests its children without their own bounding boxes.
+    /// union's box hold the whole box (povray_box_corners, which PovrayTestOrder also uses to
+    /// rebuild POV-Ray's bounding boxes). `split_union off` keeps POV-Ray from replacing the
+    /// union by its children; a union tests its children without their own bounding boxes.
     void box(const ObjectDescription& object, const Transform& to_world) {
         Vec3 lo, hi;
-        world_bounds(to_world, object.min.value, object.max.value, lo, hi);
-        double scale = 0;
-        for (int a = 0; a < 3; ++a) scale = std::max({scale, std::fabs(lo[a]), std::fabs(hi[a]), hi[a] - lo[a]});
-        const Vec3 pad(std::ldexp(scale, -20) + 1e-30);  // 2^-20: 8 to 16 floats' spacing at `scale`
+        povray_box_corners(to_world, object.min.value, object.max.value, lo, hi);
         m_out += "union { box { " + vec(object.min.value) + ", " + vec(object.max.value) + "\n    " +
-                 texture(material_of(object)) + "\n   " + matrix(to_world) + " }\n    sphere { " + vec(lo - pad) +
-                 ", 0 } sphere { " + vec(hi + pad) + ", 0 } split_union off }\n";
+                 texture(material_of(object)) + "\n   " + matrix(to_world) + " }\n    sphere { " + vec(lo) +
+                 ", 0 } sphere { " + vec(hi) + ", 0 } split_union off }\n";
     }
 
     void mesh_file(const ObjectDescription& object, const Transform& to_world) {

@@ -7,39 +7,40 @@ unlike bench/generate.py (other shapes, transforms, JSON with indentation) as a 
 made elsewhere. At its pixel (254, 237) a mirror ray starts 4e-5 above a turned box's top
 (nearer than the 1e-4 a ray must travel), crosses that box and leaves it through its bottom, in
 the floor's plane: Whitted gave that bottom the hit and POV-Ray the floor, 1,147 codes apart,
-until a plane took such a tie (accelerator.cpp, finish_hit). Coordinates keep 7 decimals: with
-3, overlapping boxes share faces, which the two renderers may give to either box
-(docs/validation.md, Known differences).
-Usage: random_boxes.py OUT_DIR [N] [SEED]"""
+until a plane took such a tie (accelerator.cpp, finish_hit). Coordinates keep 7 decimals, or
+DECIMALS: with 3 (written as random_boxes_3.json), overlapping boxes share faces, met at exactly
+the same t, and Whitted must show the box POV-Ray shows (PovrayTestOrder; seed 1 failed the cap
+by 14,831 codes before, docs/validation.md, Known differences).
+Usage: random_boxes.py OUT_DIR [N] [SEED] [DECIMALS]"""
 import json
 import random
 import sys
 from pathlib import Path
 
 
-def scene(n: int, seed: int) -> dict:
+def scene(n: int, seed: int, decimals: int = 7) -> dict:
     rng = random.Random(seed)
     objects = [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "material": "floor"}]
     for _ in range(n):
         x, z = rng.uniform(-20, 20), rng.uniform(-20, 10)
         kind = rng.random()
         if kind < 0.4:
-            w, h, d = [round(rng.uniform(0.05, 0.4), 7) for _ in range(3)]
+            w, h, d = [round(rng.uniform(0.05, 0.4), decimals) for _ in range(3)]
             objects.append({"type": "box", "min": [-w, 0, -d], "max": [w, h, d], "material": rng.choice("abc"),
                             "transform": [{"rotate": {"axis": [0, 1, 0], "angle": round(rng.uniform(0, 180), 2)}},
-                                          {"translate": [round(x, 7), 0, round(z, 7)]}]})
+                                          {"translate": [round(x, decimals), 0, round(z, decimals)]}]})
         elif kind < 0.7:
-            lo = [round(x, 7), 0, round(z, 7)]
+            lo = [round(x, decimals), 0, round(z, decimals)]
             objects.append({"type": "box", "min": lo,
-                            "max": [round(lo[0] + rng.uniform(0.05, 0.5), 7), round(rng.uniform(0.05, 0.6), 7),
-                                    round(lo[2] + rng.uniform(0.05, 0.5), 7)],
+                            "max": [round(lo[0] + rng.uniform(0.05, 0.5), decimals), round(rng.uniform(0.05, 0.6), decimals),
+                                    round(lo[2] + rng.uniform(0.05, 0.5), decimals)],
                             "material": rng.choice("abc")})
         else:
             r = round(rng.uniform(0.05, 0.3), 3)
             objects.append({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": rng.choice("abc"),
                             "transform": [{"scale": [r, round(r * rng.uniform(0.5, 2), 3), r]},
                                           {"rotate": {"axis": [1, 0, 0], "angle": round(rng.uniform(0, 90), 1)}},
-                                          {"translate": [round(x, 7), r * 1.5, round(z, 7)]}]})
+                                          {"translate": [round(x, decimals), r * 1.5, round(z, decimals)]}]})
     return {"image": {"width": 400, "height": 300, "samples": 2, "background": [0.02, 0.03, 0.05]},
             "camera": {"eye": [0, 12, 24], "look_at": [0, 0, -2], "up": [0, 1, 0], "fov": 60},
             "render": {"max_depth": 3},
@@ -58,8 +59,10 @@ def main() -> int:
     out = Path(sys.argv[1])
     n = int(sys.argv[2]) if len(sys.argv) > 2 else 20000
     seed = int(sys.argv[3]) if len(sys.argv) > 3 else 1
+    decimals = int(sys.argv[4]) if len(sys.argv) > 4 else 7
     out.mkdir(parents=True, exist_ok=True)
-    (out / "random_boxes.json").write_text(json.dumps(scene(n, seed), indent=1) + "\n")
+    name = "random_boxes.json" if decimals == 7 else f"random_boxes_{decimals}.json"
+    (out / name).write_text(json.dumps(scene(n, seed, decimals), indent=1) + "\n")
     return 0
 
 

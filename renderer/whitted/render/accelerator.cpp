@@ -3,6 +3,7 @@
 
 #include "whitted/core/packet_array.h"
 #include "whitted/geometry/shapes.h"
+#include "whitted/render/povray_order.h"
 
 #include <embree3/rtcore.h>
 
@@ -12,6 +13,7 @@
 #include <cstdlib>
 #include <deque>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <new>
 #include <stdexcept>
@@ -22,6 +24,7 @@
 #include <sys/mman.h>
 
 #include <tbb/blocked_range.h>
+#include <tbb/collaborative_call_once.h>
 #include <tbb/parallel_for.h>
 
 namespace whitted {
@@ -65,6 +68,16 @@ struct QueryContext {
     /// Whether that hit's face came from the box edge rule (ShapeHit::edge_tie): another box's
     /// plain hit at the same t then wins over it (analytic_intersect).
     bool best_edge_tie[Accelerator::packet_size];
+    /// Whether another sphere or box was met at exactly that t: which of them shows is then
+    /// POV-Ray's choice (finish_hit, PovrayTestOrder), not the order Embree met them in.
+    bool best_tied[Accelerator::packet_size];
+
+    /// A query starts with nothing held, up to the ray's own limit.
+    void start(int id, const Ray& ray) {
+        best_t[id] = ray.t_max;
+        best_edge_tie[id] = false;
+        best_tied[id] = false;
+    }
 };
 
 struct AnalyticGeometry {
@@ -109,18 +122,25 @@ void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
         if (!args->valid[i]) continue;
         const unsigned id = RTCRayN_id(rays, args->N, i);
         if (!context->is_query(id)) continue;
+        const Ray& ray = context->rays[id];
         const double limit = std::min(context->best_t[id], double(RTCRayN_tfar(rays, args->N, i)));
-        // Overlapping boxes with coplanar faces can be met at the very same t, one of them on a
-        // face the edge rule chose (a ray along one box's edge, inside another's top). POV-Ray
-        // then shows the plain face: it tests the other box first, its bounding box being met
-        // earlier, and keeps the first of equal hits (bench/generate.py --boxes 1000000, row
-        // 383). So a plain hit at the same t replaces an edge-rule one, whatever the order here.
-        const bool equal_may_win = context->best_edge_tie[id] && limit == context->best_t[id];
+        // Up to and including the limit, to see a hit at exactly the t of the one held.
         ShapeHit hit;
-        if (!intersect_analytic(*geometry, args->primID, context->rays[id],
-                                equal_may_win ? std::nextafter(limit, INFINITY) : limit, hit))
-            continue;
-        if (equal_may_win && hit.t == limit && hit.edge_tie) continue;
+        if (!intersect_analytic(*geometry, args->primID, ray, std::nextafter(limit, INFINITY), hit)) continue;
+        if (hit.t == limit) {
+            // At a triangle's (float) distance, or at the ray's end: the candidate does not win.
+            if (limit != context->best_t[id] || !(limit < ray.t_max)) continue;
+            // An exact tie with the sphere or box held: overlapping boxes with faces in one
+            // plane. finish_hit asks POV-Ray's order which of them shows. Without that order
+            // (a scene with meshes), a plain face at the same t replaces a face the edge rule
+            // chose (a ray along one box's edge, inside another's top): POV-Ray then tests the
+            // other box first, its bounding box being met earlier (bench/generate.py --boxes
+            // 1000000, row 383).
+            context->best_tied[id] = true;
+            if (!(context->best_edge_tie[id] && !hit.edge_tie)) continue;
+        } else {
+            context->best_tied[id] = false;
+        }
         context->best_t[id] = hit.t;
         context->best_normal[id] = hit.normal;
         context->best_edge_tie[id] = hit.edge_tie;
@@ -616,6 +636,11 @@ struct Accelerator::Impl {
     /// float's precision relative to its own size; every answer is still recomputed in world
     /// double from the scene's own data.
     EmbreeFrame frame;
+    /// POV-Ray's order of testing the spheres and boxes, for rays that meet two at exactly the
+    /// same t (tie_order); built on the first such ray, so a scene without ties never pays (a
+    /// million equal cubes pay 0.5-0.8 s and 200 MB, docs/performance.md).
+    mutable tbb::collaborative_once_flag tie_order_built;
+    mutable std::unique_ptr<PovrayTestOrder> tie_order_data;
 
     Impl(const Scene& s, int threads, const std::string& instruction_set) : scene(s), isa(instruction_set) {
         spheres.scene = boxes.scene = &scene;
@@ -667,6 +692,13 @@ struct Accelerator::Impl {
     }
 
     ~Impl() { release(); }
+
+    const PovrayTestOrder& tie_order() const {
+        // The threads that wait help build it (its sorts split work).
+        tbb::collaborative_call_once(tie_order_built,
+                                     [&] { tie_order_data = std::make_unique<PovrayTestOrder>(scene); });
+        return *tie_order_data;
+    }
 
     /// A BVH is built once per triangle and traversed once per ray. HIGH quality took 2.0 s to
     /// build 1M triangles against 0.2 s for MEDIUM, for a few percent faster traversal that a
@@ -920,7 +952,7 @@ struct Accelerator::Impl {
     /// `inst`: Embree's instance geomID when the candidate is a prototype's triangle (`geom` is
     /// then its mesh in the prototype), else RTC_INVALID_GEOMETRY_ID.
     bool finish_hit(const Ray& ray, unsigned inst, unsigned geom, unsigned prim, double best_t, const Vec3& best_normal,
-                    SurfaceHit& out, bool& retry) const {
+                    bool tied, SurfaceHit& out, bool& retry) const {
         retry = false;
         bool found = false;
         double t_max = ray.t_max;
@@ -959,10 +991,16 @@ struct Accelerator::Impl {
                 out.material = mesh.triangle_materials.empty() ? mesh.material : mesh.triangle_materials[prim];
                 out.object = mesh.object;
             } else {
-                // The callback computed this hit in double and kept it.
+                // The callback computed this hit in double and kept it; of several at exactly
+                // that t, the one POV-Ray tests first shows (PovrayTestOrder).
                 hit.t = best_t;
-                out.normal = out.geometric_normal = normalize(best_normal);
-                if (kinds[geom] == ShapeKind::spheres)
+                Vec3 normal = best_normal;
+                bool sphere = kinds[geom] == ShapeKind::spheres;
+                PovrayTestOrder::Found first;
+                if (tied && tie_order().nearest(ray, first, best_t) && first.hit.t == best_t)
+                    sphere = first.sphere, prim = first.index, normal = first.hit.normal;
+                out.normal = out.geometric_normal = normalize(normal);
+                if (sphere)
                     out.material = scene.spheres[prim].material, out.object = scene.spheres[prim].object;
                 else
                     out.material = scene.boxes[prim].material, out.object = scene.boxes[prim].object;
@@ -1007,22 +1045,21 @@ struct Accelerator::Impl {
         const bool found = trace(ray, triangle_filter, out, retry);
         if (!retry) return found;
         // Not expected (the filter refuses what finish_hit would); if it came, the planes answer.
-        return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, {}, out, retry);
+        return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, {}, false, out, retry);
     }
 
     /// One Embree query for `ray` with `filter` on its context (null: none), and finish_hit.
     bool trace(const Ray& ray, RTCFilterFunctionN filter, SurfaceHit& out, bool& retry) const {
         QueryContext context(&ray, nullptr, 1, false);
         context.embree.filter = filter;
-        context.best_t[0] = ray.t_max;
-        context.best_edge_tie[0] = false;
+        context.start(0, ray);
         RTCRayHit rayhit;
         rayhit.ray = make_embree_ray(ray, 0, frame);
         rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(rtc_scene, &context.embree, &rayhit);
         return finish_hit(ray, rayhit.hit.instID[0], rayhit.hit.geomID, rayhit.hit.primID, context.best_t[0],
-                          context.best_normal[0], out, retry);
+                          context.best_normal[0], context.best_tied[0], out, retry);
     }
 
     /// Calls `lanes.operator()<W>(first)` for first = 0, W, 2W, ... < count, with W the native
@@ -1067,8 +1104,7 @@ struct Accelerator::Impl {
             valid[lane] = is_query ? -1 : 0;
             any |= is_query;
             if (is_query) {
-                context.best_t[i] = rays[i].t_max;
-                context.best_edge_tie[i] = false;
+                context.start(i, rays[i]);
                 set_lane(packet.ray, lane, rays[i], unsigned(i), frame);
             } else {
                 set_empty_lane(packet.ray, lane, unsigned(i));
@@ -1083,7 +1119,7 @@ struct Accelerator::Impl {
             if (!valid[lane]) continue;
             bool retry = false;
             found[i] = finish_hit(rays[i], packet.hit.instID[0][lane], packet.hit.geomID[lane], packet.hit.primID[lane],
-                                  context.best_t[i], context.best_normal[i], hits[i], retry);
+                                  context.best_t[i], context.best_normal[i], context.best_tied[i], hits[i], retry);
             if (retry) found[i] = intersect_again(rays[i], hits[i]);
         }
     }
