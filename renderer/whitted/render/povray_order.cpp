@@ -86,7 +86,7 @@ Bounds box_bounds(const Box& box) {
     double mins[3] = {bound_huge, bound_huge, bound_huge}, maxs[3] = {-bound_huge, -bound_huge, -bound_huge};
     for (const Bounds& child : children)
         for (int a = 0; a < 3; ++a) {
-            const double lower = child.lower[a], upper = lower + double(child.length[a]);
+            const double lower = double(child.lower[a]), upper = lower + double(child.length[a]);
             mins[a] = std::min(mins[a], lower);
             maxs[a] = std::max(maxs[a], upper);
         }
@@ -159,11 +159,11 @@ struct SlabRay {
             const float near_plane = (b.lower[0] - origin[0]) * reciprocal[0];
             const float across = b.length[0] * reciprocal[0];
             if (positive[0]) {
-                dmin = near_plane;
+                dmin = double(near_plane);
                 dmax = dmin + double(across);
                 if (dmax < epsilon) return false;
             } else {
-                dmax = near_plane;
+                dmax = double(near_plane);
                 if (dmax < epsilon) return false;
                 dmin = dmax + double(across);
             }
@@ -178,8 +178,8 @@ struct SlabRay {
                 if (origin[a] < b.lower[a] || origin[a] > b.length[a] + b.lower[a]) return false;
                 continue;
             }
-            const double lower_plane = float((b.lower[a] - origin[a]) * reciprocal[a]);
-            const double across = float(b.length[a] * reciprocal[a]);
+            const double lower_plane = double((b.lower[a] - origin[a]) * reciprocal[a]);  // a float product
+            const double across = double(b.length[a] * reciprocal[a]);
             double tmin, tmax;
             if (positive[a]) {
                 tmin = lower_plane;
@@ -310,7 +310,7 @@ PovrayTestOrder::Item PovrayTestOrder::make_parent(const std::vector<Item>& item
         m_children.push_back(items[i].node);
         const Bounds& b = items[i].bounds;
         for (int a = 0; a < 3; ++a) {
-            const double lower = b.lower[a], upper = lower + double(b.length[a]);
+            const double lower = double(b.lower[a]), upper = lower + double(b.length[a]);
             if (lower < mins[a]) mins[a] = lower;
             if (upper > maxs[a]) maxs[a] = upper;
         }
@@ -343,7 +343,8 @@ void PovrayTestOrder::split(std::vector<Item>& finite, size_t first, size_t last
     std::vector<Range> todo{{first, last}};
     auto& [area_right, keys, keys_scratch, items_scratch] = scratch;
     while (!todo.empty()) {
-        const auto [f, l] = todo.back();
+        // Plain variables, not a structured binding: lambdas below capture them (clang 14).
+        const size_t f = todo.back().first, l = todo.back().last;
         todo.pop_back();
         const size_t size = l - f;
         if (size == 0) {
@@ -404,7 +405,7 @@ void PovrayTestOrder::split(std::vector<Item>& finite, size_t first, size_t last
             double lo[3] = {bound_huge, bound_huge, bound_huge}, hi[3] = {-bound_huge, -bound_huge, -bound_huge};
             double add(const Bounds& b) {
                 for (int a = 0; a < 3; ++a) {
-                    const double lower = b.lower[a], upper = lower + double(b.length[a]);
+                    const double lower = double(b.lower[a]), upper = lower + double(b.length[a]);
                     if (lower < lo[a]) lo[a] = lower;
                     if (upper > hi[a]) hi[a] = upper;
                 }
