@@ -101,8 +101,9 @@ Transform Transform::rotate(const Vec3& axis, double degrees) {
 }
 
 Transform Transform::then(const Transform& b) const {
-    // With the identity on either side the product is the other, bit for bit (and its inverse,
-    // from the same rows): most objects have no transform, and inverting costs.
+    // With the identity on either side the product is the other (and its inverse, from the same
+    // rows); multiplying would give the same values, though a −0 entry could come out +0. Most
+    // objects have no transform, and inverting costs.
     if (b.m_identity) return *this;
     if (m_identity) return b;
     Transform r;

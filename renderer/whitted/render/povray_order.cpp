@@ -38,6 +38,27 @@ Bounds from_min_max(const double mins[3], const double maxs[3]) {
     return b;
 }
 
+/// The box around several boxes, grown one at a time from each one's corner and far corner
+/// (corner + size, in double): how POV-Ray encloses a union's children, a node's, and the items
+/// either side of a split.
+struct Around {
+    double lo[3] = {bound_huge, bound_huge, bound_huge}, hi[3] = {-bound_huge, -bound_huge, -bound_huge};
+
+    void add(const Bounds& b) {
+        for (int a = 0; a < 3; ++a) {
+            const double lower = double(b.lower[a]), upper = lower + double(b.length[a]);
+            if (lower < lo[a]) lo[a] = lower;
+            if (upper > hi[a]) hi[a] = upper;
+        }
+    }
+    /// Half its surface area, the split cost's measure.
+    double area() const {
+        const double x = hi[0] - lo[0], y = hi[1] - lo[1], z = hi[2] - lo[2];
+        return x * (y + z) + y * z;
+    }
+    Bounds bounds() const { return from_min_max(lo, hi); }
+};
+
 /// A transformed shape's box: its eight corners through the matrix, as POV-Ray multiplies a
 /// point by its (row-vector) matrix, whose rows are our columns (pov_writer.cpp, `matrix`).
 Bounds transformed(const Bounds& b, const Transform& to_world) {
@@ -82,15 +103,9 @@ Bounds box_bounds(const Box& box) {
     if (box.object_to_world) inner = transformed(inner, *box.object_to_world);
     Vec3 lo, hi;
     povray_box_corners(transform_of(box.object_to_world), box.min, box.max, lo, hi);
-    const Bounds children[3] = {inner, sphere_bounds(lo, 0, nullptr), sphere_bounds(hi, 0, nullptr)};
-    double mins[3] = {bound_huge, bound_huge, bound_huge}, maxs[3] = {-bound_huge, -bound_huge, -bound_huge};
-    for (const Bounds& child : children)
-        for (int a = 0; a < 3; ++a) {
-            const double lower = double(child.lower[a]), upper = lower + double(child.length[a]);
-            mins[a] = std::min(mins[a], lower);
-            maxs[a] = std::max(maxs[a], upper);
-        }
-    Bounds b = from_min_max(mins, maxs);
+    Around around;
+    for (const Bounds& child : {inner, sphere_bounds(lo, 0, nullptr), sphere_bounds(hi, 0, nullptr)}) around.add(child);
+    Bounds b = around.bounds();
     if (double(b.length[0]) > critical_length || double(b.length[1]) > critical_length ||
         double(b.length[2]) > critical_length) {
         for (int a = 0; a < 3; ++a) b.lower[a] = float(-bound_huge / 2), b.length[a] = float(bound_huge);
@@ -305,17 +320,12 @@ PovrayTestOrder::Item PovrayTestOrder::make_parent(const std::vector<Item>& item
     Node parent;
     parent.first_child = uint32_t(m_children.size());
     parent.child_count = uint32_t(last - first);
-    double mins[3] = {bound_huge, bound_huge, bound_huge}, maxs[3] = {-bound_huge, -bound_huge, -bound_huge};
+    Around around;
     for (size_t i = first; i < last; ++i) {
         m_children.push_back(items[i].node);
-        const Bounds& b = items[i].bounds;
-        for (int a = 0; a < 3; ++a) {
-            const double lower = double(b.lower[a]), upper = lower + double(b.length[a]);
-            if (lower < mins[a]) mins[a] = lower;
-            if (upper > maxs[a]) maxs[a] = upper;
-        }
+        around.add(items[i].bounds);
     }
-    parent.bounds = from_min_max(mins, maxs);
+    parent.bounds = around.bounds();
     m_nodes.push_back(parent);
     return {parent.bounds, uint32_t(m_nodes.size() - 1)};
 }
@@ -401,27 +411,18 @@ void PovrayTestOrder::split(std::vector<Item>& finite, size_t first, size_t last
         // The surface area of the box around the items from i on (area_right), then, sweeping
         // from the left, around those up to i: a split after i costs (i + 1) · left + the rest
         // · right.
-        struct Around {
-            double lo[3] = {bound_huge, bound_huge, bound_huge}, hi[3] = {-bound_huge, -bound_huge, -bound_huge};
-            double add(const Bounds& b) {
-                for (int a = 0; a < 3; ++a) {
-                    const double lower = double(b.lower[a]), upper = lower + double(b.length[a]);
-                    if (lower < lo[a]) lo[a] = lower;
-                    if (upper > hi[a]) hi[a] = upper;
-                }
-                const double x = hi[0] - lo[0], y = hi[1] - lo[1], z = hi[2] - lo[2];
-                return x * (y + z) + y * z;
-            }
-        };
         area_right.resize(size);
         Around right_of;
-        for (size_t i = size; i-- > 0;) area_right[i] = right_of.add(finite[f + i].bounds);
+        for (size_t i = size; i-- > 0;) {
+            right_of.add(finite[f + i].bounds);
+            area_right[i] = right_of.area();
+        }
         double best = area_right[0] * (double(size) - 3.0);
         std::ptrdiff_t best_at = -1;
         Around left_of;
         for (size_t i = 0; i + 1 < size; ++i) {
-            const double area_left = left_of.add(finite[f + i].bounds);
-            const double cost = double(i + 1) * area_left + double(size - 1 - i) * area_right[i + 1];
+            left_of.add(finite[f + i].bounds);
+            const double cost = double(i + 1) * left_of.area() + double(size - 1 - i) * area_right[i + 1];
             if (cost < best) best = cost, best_at = std::ptrdiff_t(i + f);
         }
         if (size <= bunching || best_at < 0) {
