@@ -22,6 +22,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include <sys/prctl.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -534,8 +535,13 @@ bool embree_isa_usable() {
 }  // namespace
 
 int main(int argc, char** argv) {
-    // Transparent huge pages stay on: Embree asks for them for its BVH, and this program's
-    // operator new for every block of 2 MiB or more (huge_pages.cpp, docs/performance.md).
+    // Transparent huge pages off for this process. Embree asks for them (madvise) for all its
+    // BVH memory. On the virtual machines Whitted is measured on, the host takes back the
+    // guest's free memory in 2 MiB blocks (virtio-balloon free page reporting), and a huge
+    // page is exactly such a block: its first touch is then 512 faults on the host. The
+    // 1M-triangle build took 0.37-0.40 s in three runs of five against 0.11 s with ordinary
+    // pages, and no scene rendered faster with them (docs/performance.md, "Huge pages").
+    prctl(PR_SET_THP_DISABLE, 1, 0, 0, 0);
     CLI::App app{
         "Whitted: an offline ray tracer for the classic lecture shading model\n"
         "  L = ka*Ia + sum_i [kd*I_i*max(0,n.l_i) + ks*I_i*max(0,n.h_i)^p] + km*L(r)\n"

@@ -294,12 +294,11 @@ void triangle_filter(const RTCFilterFunctionNArguments* args) {
     }
 }
 
-/// An array for Embree to read (the widened corners, their indices), in zeroed anonymous memory
-/// offered for transparent huge pages (MADV_HUGEPAGE). It is written once, front to back, right
-/// after: in 4 KiB pages every page is a fault of its own, and on the virtual machine of
-/// docs/performance.md the faults cost more than the writing. Huge pages beat mapping the
-/// array in whole first (MAP_POPULATE, 4 KiB pages): torus1m 0.47-0.55 s against 0.52-0.59 s
-/// whole process, and the library gets them without the program's operator new.
+/// An array for Embree to read (the widened corners, their indices), in anonymous memory that
+/// the kernel maps in whole as it is made (MAP_POPULATE) and zeroes. It is written once, front
+/// to back, right after: touched a page at a time instead, every 4 KiB is a page fault, and on
+/// the virtual machine of docs/performance.md the faults cost more than the writing. Ordinary
+/// pages, not transparent huge ones: see `main` (renderer/app/main.cpp) for why.
 template <class T>
 class MappedArray {
 public:
@@ -307,9 +306,9 @@ public:
     /// `count` elements and `padding` bytes after them (zero, as the whole mapping is).
     MappedArray(size_t count, size_t padding) : m_bytes(count * sizeof(T) + padding) {
         if (m_bytes == 0) return;
-        void* memory = mmap(nullptr, m_bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        void* memory =
+            mmap(nullptr, m_bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
         if (memory == MAP_FAILED) throw std::bad_alloc();
-        ::madvise(memory, m_bytes, MADV_HUGEPAGE);  // advice: ordinary pages where there are none
         m_data = static_cast<T*>(memory);
     }
     MappedArray(MappedArray&& other) noexcept
