@@ -7,7 +7,11 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
 #include <utility>
 
 namespace whitted {
@@ -363,6 +367,31 @@ TEST(Sphere, SmallAndFarStaysAccurate) {
         ShapeHit miss;
         EXPECT_FALSE(intersect_sphere(sphere, {{0.3 + 1.01 * r, -0.2, 0}, {0, 0, 1}, t_min, 1e9}, t_min, 1e9, miss));
     }
+}
+
+// next_up (vec3.h) stands in for std::nextafter(x, +infinity) on the hot path: the same value,
+// bit for bit, at the special values and at a million random bit patterns of each width.
+template <class Real, class Bits>
+void expect_next_up_is_nextafter() {
+    const Real inf = std::numeric_limits<Real>::infinity();
+    const Real special[] = {Real(0), -Real(0), std::numeric_limits<Real>::denorm_min(),
+                            -std::numeric_limits<Real>::denorm_min(), std::numeric_limits<Real>::min(),
+                            -std::numeric_limits<Real>::min(), std::numeric_limits<Real>::max(),
+                            -std::numeric_limits<Real>::max(), inf, -inf, Real(1), Real(-1), Real(0.1), Real(-0.1)};
+    for (const Real x : special)
+        EXPECT_EQ(std::bit_cast<Bits>(next_up(x)), std::bit_cast<Bits>(std::nextafter(x, inf))) << x;
+    EXPECT_TRUE(std::isnan(next_up(std::numeric_limits<Real>::quiet_NaN())));
+    std::mt19937_64 random(4620);
+    for (int i = 0; i < 1000000; ++i) {
+        const Real x = std::bit_cast<Real>(Bits(random()));
+        if (std::isnan(x)) continue;
+        ASSERT_EQ(std::bit_cast<Bits>(next_up(x)), std::bit_cast<Bits>(std::nextafter(x, inf))) << x;
+    }
+}
+
+TEST(NextUp, IsNextafterTowardInfinity) {
+    expect_next_up_is_nextafter<double, uint64_t>();
+    expect_next_up_is_nextafter<float, uint32_t>();
 }
 
 }  // namespace

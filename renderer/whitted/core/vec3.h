@@ -1,7 +1,11 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <type_traits>
 
 namespace whitted {
 
@@ -22,6 +26,21 @@ inline double float_rounded(double x) {
     f = held;
 #endif
     return f;
+}
+
+/// The next value above `x`: what std::nextafter(x, +infinity) returns, bit for bit, but inline.
+/// The analytic callbacks ask for it on every candidate hit, where the library call was 2 % of
+/// the spheres anchor's render time. For finite x the neighbour above is one step of the bit
+/// pattern: up for positive x, down (toward zero) for negative x; 0 and -0 step to the smallest
+/// subnormal; +infinity and NaN stay as they are.
+template <class Real>
+inline Real next_up(Real x) {
+    using Bits = std::conditional_t<sizeof(Real) == 8, uint64_t, uint32_t>;
+    static_assert(std::numeric_limits<Real>::is_iec559 && sizeof(Real) == sizeof(Bits));
+    if (!(x < std::numeric_limits<Real>::infinity())) return x;
+    if (x == 0) return std::numeric_limits<Real>::denorm_min();
+    const Bits bits = std::bit_cast<Bits>(x);
+    return std::bit_cast<Real>(x > 0 ? Bits(bits + 1) : Bits(bits - 1));
 }
 
 /// A 3-vector of doubles. Geometry and shading run in double precision because POV-Ray, the

@@ -137,7 +137,7 @@ void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
         const double limit = std::min(context->best_t[id], double(RTCRayN_tfar(rays, args->N, i)));
         // Up to and including the limit, to see a hit at exactly the t of the one held.
         ShapeHit hit;
-        if (!intersect_analytic(*geometry, args->primID, ray, std::nextafter(limit, INFINITY), hit)) continue;
+        if (!intersect_analytic(*geometry, args->primID, ray, next_up(limit), hit)) continue;
         const auto [material, object] = material_and_object(*geometry, args->primID);
         if (hit.t == limit) {
             // At a triangle's (float) distance, or at the ray's end: the candidate does not win.
@@ -173,7 +173,7 @@ void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
         context->best_material[id] = material;
         context->best_object[id] = object;
         // Round the float distance up so Embree keeps visiting boxes that may hold a closer hit.
-        RTCRayN_tfar(rays, args->N, i) = std::nextafter(float(hit.t), INFINITY);
+        RTCRayN_tfar(rays, args->N, i) = next_up(float(hit.t));
         RTCHitN_geomID(hits, args->N, i) = args->geomID;
         RTCHitN_primID(hits, args->N, i) = args->primID;
         RTCHitN_instID(hits, args->N, i, 0) = RTC_INVALID_GEOMETRY_ID;
@@ -414,7 +414,7 @@ struct EmbreeFrame {
 
     float t_min(const Ray& ray) const { return exact_range ? 0.0f : float(ray.t_min); }
     float t_max(const Ray& ray) const {
-        return exact_range ? std::nextafter(float(ray.t_max * (1 + 1e-6)), INFINITY) : float(ray.t_max);
+        return exact_range ? next_up(float(ray.t_max * (1 + 1e-6))) : float(ray.t_max);
     }
 };
 
@@ -1040,7 +1040,7 @@ struct Accelerator::Impl {
         // on the floor, met by a ray inside the box. POV-Ray, which the cross-check compares
         // with, shows the plane there (docs/pov-model.md §3, "A plane keeps a tie"). Among the
         // planes the first one keeps it.
-        double plane_t_max = found ? std::nextafter(t_max, std::numeric_limits<double>::infinity()) : t_max;
+        double plane_t_max = found ? next_up(t_max) : t_max;
         for (const Plane& plane : scene.planes) {
             ShapeHit plane_hit;
             if (intersect_plane(plane, ray, ray.t_min, plane_t_max, plane_hit)) {
