@@ -374,10 +374,20 @@ TEST(Sphere, SmallAndFarStaysAccurate) {
 template <class Real, class Bits>
 void expect_next_up_is_nextafter() {
     const Real inf = std::numeric_limits<Real>::infinity();
-    const Real special[] = {Real(0), -Real(0), std::numeric_limits<Real>::denorm_min(),
-                            -std::numeric_limits<Real>::denorm_min(), std::numeric_limits<Real>::min(),
-                            -std::numeric_limits<Real>::min(), std::numeric_limits<Real>::max(),
-                            -std::numeric_limits<Real>::max(), inf, -inf, Real(1), Real(-1), Real(0.1), Real(-0.1)};
+    const Real special[] = {Real(0),
+                            -Real(0),
+                            std::numeric_limits<Real>::denorm_min(),
+                            -std::numeric_limits<Real>::denorm_min(),
+                            std::numeric_limits<Real>::min(),
+                            -std::numeric_limits<Real>::min(),
+                            std::numeric_limits<Real>::max(),
+                            -std::numeric_limits<Real>::max(),
+                            inf,
+                            -inf,
+                            Real(1),
+                            Real(-1),
+                            Real(0.1),
+                            Real(-0.1)};
     for (const Real x : special)
         EXPECT_EQ(std::bit_cast<Bits>(next_up(x)), std::bit_cast<Bits>(std::nextafter(x, inf))) << x;
     EXPECT_TRUE(std::isnan(next_up(std::numeric_limits<Real>::quiet_NaN())));
