@@ -307,7 +307,7 @@ private:
             const Vec3 w = to_world.apply_point(v);
             world.push_back({float_rounded(w.x), float_rounded(w.y), float_rounded(w.z)});
         }
-        const Vec3 centre = mesh_centre(world);
+        const Vec3 centre = povray_mesh_centre(world.size(), [&](size_t i) { return world[i]; });
         o += "mesh2 {\n  vertex_vectors { " + std::to_string(vertices.size());
         for (const Vec3& w : world) o += ",\n    " + vec(w - centre);
         o += " }\n";
@@ -337,24 +337,6 @@ private:
         if (!(centre == Vec3(0.0))) o += "  translate " + vec(centre) + "\n";
         o += "}\n";
         if (m_collect) m_collect->push_back({std::move(piece), material});
-    }
-
-    /// Per axis: a float near the vertices' middle, if the mesh is far out on that axis (beyond
-    /// far_mesh_coordinate) and every vertex minus it is exactly a float; else 0 (no move).
-    static Vec3 mesh_centre(const std::vector<Vec3>& world) {
-        constexpr double far_mesh_coordinate = 16;  // below it, float plane distances are within 1e-6
-        double centre[3] = {0, 0, 0};
-        if (world.empty()) return Vec3(0.0);
-        for (int axis = 0; axis < 3; ++axis) {
-            double lo = INFINITY, hi = -INFINITY;
-            for (const Vec3& w : world) lo = std::min(lo, w[axis]), hi = std::max(hi, w[axis]);
-            if (std::max(std::fabs(lo), std::fabs(hi)) < far_mesh_coordinate) continue;
-            const double c = float(0.5 * (lo + hi));
-            bool exact = true;
-            for (const Vec3& w : world) exact = exact && double(float(w[axis] - c)) == w[axis] - c;
-            if (exact) centre[axis] = c;
-        }
-        return {centre[0], centre[1], centre[2]};
     }
 
     const SceneDescription& m_description;

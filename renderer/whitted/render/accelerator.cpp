@@ -156,10 +156,9 @@ void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
                 // one box's edge, inside another's top): POV-Ray then tests the other box
                 // first, its bounding box being met earlier (bench/generate.py --boxes 1000000,
                 // row 383). Where that is the only difference (one material) the rule decides;
-                // otherwise finish_hit asks POV-Ray's order (PovrayTestOrder), and the rule
-                // stands only where that order is not known (a scene with meshes). Rebuilding
-                // the order costs a million equal cubes 0.6 s, which ties of one material
-                // whose faces differ only by the edge rule need not pay.
+                // otherwise finish_hit asks POV-Ray's order (PovrayTestOrder). Rebuilding the
+                // order costs a million equal cubes 0.6 s, which ties of one material whose
+                // faces differ only by the edge rule need not pay.
                 if (!(material == context->best_material[id] && hit.edge_tie != context->best_edge_tie[id]))
                     context->best_tied[id] = true;
                 if (!(context->best_edge_tie[id] && !hit.edge_tie)) continue;

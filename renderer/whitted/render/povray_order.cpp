@@ -113,6 +113,51 @@ Bounds box_bounds(const Box& box) {
     return b;
 }
 
+/// POV-Ray's boxes of the mesh2 objects `whitted convert` writes for `mesh`, one per material
+/// (in the order of the materials' numbers), appended to `out`. A mesh2's box holds its
+/// triangles' float vertices (POV-Ray's Mesh::Compute_BBox: the least and greatest coordinate
+/// over its triangles), written about the mesh's centre, then moved there by `translate`,
+/// which recomputes the box as any transform does.
+void mesh_bounds(const TriangleMesh& mesh, std::vector<Bounds>& out) {
+    const auto vertex = [&](size_t i) {
+        const float* p = &mesh.positions[4 * i];
+        return Vec3(p[0], p[1], p[2]);
+    };
+    const Vec3 centre = povray_mesh_centre(mesh.vertex_count(), vertex);
+    std::vector<uint32_t> materials(mesh.triangle_materials);
+    std::sort(materials.begin(), materials.end());
+    materials.erase(std::unique(materials.begin(), materials.end()), materials.end());
+    if (materials.empty()) materials.push_back(mesh.material);
+    std::vector<Around> pieces(materials.size());
+    for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+        const size_t piece =
+            mesh.triangle_materials.empty()
+                ? 0
+                : size_t(std::lower_bound(materials.begin(), materials.end(), mesh.triangle_materials[t]) -
+                         materials.begin());
+        Around& around = pieces[piece];
+        for (int k = 0; k < 3; ++k) {
+            const Vec3 v = vertex(mesh.indices[3 * t + k]) - centre;  // exact: povray_mesh_centre
+            for (int a = 0; a < 3; ++a)
+                around.lo[a] = std::min(around.lo[a], v[a]), around.hi[a] = std::max(around.hi[a], v[a]);
+        }
+    }
+    for (const Around& piece : pieces) {
+        Bounds b = piece.bounds();
+        if (!(centre == Vec3(0.0))) b = transformed(b, Transform::translate(centre));
+        out.push_back(b);
+    }
+}
+
+/// POV-Ray's box of one piece of an instance as `whitted convert` writes it, `object { PIECE
+/// matrix }`: the piece's box through the matrix. An instance of several pieces is a `union`
+/// of them with the matrix on the union; POV-Ray splits such a union (no `split_union off`, no
+/// `bounded_by`) and bounds each piece on its own, each moved by the matrix (CSG::Transform
+/// transforms the children).
+Bounds placed_bounds(const Bounds& piece, const Transform& to_world) {
+    return to_world.is_identity() ? piece : transformed(piece, to_world);  // no `matrix` for the identity
+}
+
 /// The queue: a binary heap on entry distance, 1-based, with POV-Ray's sifting (which decides
 /// the order of equal keys).
 class Queue {
@@ -233,9 +278,23 @@ void povray_box_corners(const Transform& to_world, const Vec3& min, const Vec3& 
     hi += pad;
 }
 
+Vec3 povray_mesh_centre(size_t count, const std::function<Vec3(size_t)>& vertex) {
+    constexpr double far_mesh_coordinate = 16;  // below it, float plane distances are within 1e-6
+    double centre[3] = {0, 0, 0};
+    if (count == 0) return Vec3(0.0);
+    for (int axis = 0; axis < 3; ++axis) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (size_t i = 0; i < count; ++i) lo = std::min(lo, vertex(i)[axis]), hi = std::max(hi, vertex(i)[axis]);
+        if (std::max(std::fabs(lo), std::fabs(hi)) < far_mesh_coordinate) continue;
+        const double c = float(0.5 * (lo + hi));
+        bool exact = true;
+        for (size_t i = 0; i < count && exact; ++i) exact = double(float(vertex(i)[axis] - c)) == vertex(i)[axis] - c;
+        if (exact) centre[axis] = c;
+    }
+    return {centre[0], centre[1], centre[2]};
+}
+
 PovrayTestOrder::PovrayTestOrder(const Scene& scene) : m_scene(scene) {
-    if (!scene.meshes.empty() || !scene.instances.empty()) return;
-    m_usable = true;
     // The converted scene's order: every object where the scene file has it (Scene::objects).
     const size_t spheres = scene.spheres.size(), boxes = scene.boxes.size();
     {
@@ -249,6 +308,23 @@ PovrayTestOrder::PovrayTestOrder(const Scene& scene) : m_scene(scene) {
         for (size_t i = 0; i < scene.planes.size(); ++i)
             kind.emplace_back(scene.planes[i].object, uint32_t(spheres + boxes + i));
         std::merge(by_object.begin(), by_object.end(), kind.begin(), kind.end(), std::back_inserter(merged));
+        // Then the mesh objects, each after the planes (its pieces numbered in their order).
+        const uint32_t first_mesh = uint32_t(spheres + boxes + scene.planes.size());
+        for (const TriangleMesh& mesh : scene.meshes) {
+            const size_t before = m_mesh_bounds.size();
+            mesh_bounds(mesh, m_mesh_bounds);
+            for (size_t k = before; k < m_mesh_bounds.size(); ++k)
+                merged.emplace_back(mesh.object, uint32_t(first_mesh + k));
+        }
+        std::vector<std::vector<Bounds>> prototype_pieces(scene.prototypes.size());
+        for (size_t p = 0; p < scene.prototypes.size(); ++p)
+            for (const TriangleMesh& mesh : scene.prototypes[p].meshes) mesh_bounds(mesh, prototype_pieces[p]);
+        for (const Instance& instance : scene.instances) {
+            for (const Bounds& piece : prototype_pieces[instance.prototype]) {
+                merged.emplace_back(instance.object, uint32_t(first_mesh + m_mesh_bounds.size()));
+                m_mesh_bounds.push_back(placed_bounds(piece, instance.object_to_world));
+            }
+        }
         if (!std::is_sorted(merged.begin(), merged.end())) std::sort(merged.begin(), merged.end());
         m_order.reserve(merged.size());
         for (const auto& [object, shape] : merged) m_order.push_back(shape);
@@ -271,8 +347,10 @@ PovrayTestOrder::PovrayTestOrder(const Scene& scene) : m_scene(scene) {
             leaf.bounds = sphere_bounds(s.center, s.radius, s.object_to_world.get());
         } else if (shape < spheres + boxes) {
             leaf.bounds = box_bounds(scene.boxes[shape - spheres]);
-        } else {
+        } else if (shape < spheres + boxes + scene.planes.size()) {
             leaf.infinite = true;
+        } else {
+            leaf.bounds = m_mesh_bounds[shape - (spheres + boxes + scene.planes.size())];
         }
         if (leaf.infinite)
             infinite.push_back(uint32_t(m_nodes.size()));
@@ -280,7 +358,8 @@ PovrayTestOrder::PovrayTestOrder(const Scene& scene) : m_scene(scene) {
             finite.push_back({leaf.bounds, uint32_t(m_nodes.size())});
         m_nodes.push_back(leaf);
     }
-    std::vector<uint32_t>().swap(m_order);  // only the order without a hierarchy needs it
+    std::vector<uint32_t>().swap(m_order);      // only the order without a hierarchy needs it
+    std::vector<Bounds>().swap(m_mesh_bounds);  // in the leaves now
     build(finite, infinite);
 }
 
@@ -461,11 +540,10 @@ bool PovrayTestOrder::test(const Ray& ray, uint32_t shape, ShapeHit& hit) const 
     if (shape < spheres) return intersect_sphere(m_scene.spheres[shape], ray, ray.t_min, ray.t_max, hit);
     if (shape < spheres + m_scene.boxes.size())
         return intersect_box(m_scene.boxes[shape - spheres], ray, ray.t_min, ray.t_max, hit);
-    return false;  // a plane: not a candidate here (finish_hit weighs planes)
+    return false;  // a plane (finish_hit weighs planes) or a mesh: not a candidate here
 }
 
 bool PovrayTestOrder::nearest(const Ray& ray, Found& out, double nearest_t) const {
-    if (!m_usable) return false;
     double best = bound_huge;
     bool found = false;
     // Whether the hit is known to be nearest: nothing tested later can take its place.

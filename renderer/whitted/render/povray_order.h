@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "whitted/core/ray.h"
@@ -23,13 +24,13 @@ namespace whitted {
 /// rays with a tie are traced through it (the accelerator finds them), so a scene without ties
 /// never builds it.
 ///
-/// Scenes with meshes or instances are not covered (usable() is false): their bounding boxes
-/// would be needed too. Ties there keep Embree's order.
+/// Meshes and instances take their places in the hierarchy with the bounding boxes POV-Ray
+/// gives the mesh2 objects (and their unions) that `whitted convert` writes, so the spheres
+/// and boxes among them are met in POV-Ray's order; a mesh itself is never a candidate here
+/// (an exact tie with a triangle keeps Embree's order).
 class PovrayTestOrder {
 public:
     explicit PovrayTestOrder(const Scene& scene);
-
-    bool usable() const { return m_usable; }
 
     /// The sphere or box POV-Ray shows on `ray`: the nearest hit in (t_min, t_max), and of
     /// equally near ones the first POV-Ray tests. Planes are not among the candidates (they
@@ -55,7 +56,8 @@ private:
         bool infinite = false;
         uint32_t first_child = 0;  ///< in m_children
         uint32_t child_count = 0;  ///< 0: a leaf
-        /// A leaf's shape: spheres first, then boxes (index − spheres.size()), then planes.
+        /// A leaf's shape: spheres first, then boxes (index − spheres.size()), then planes, then
+        /// the converted scene's mesh objects (m_mesh_bounds).
         uint32_t shape = 0;
     };
 
@@ -84,11 +86,13 @@ private:
     bool test(const Ray& ray, uint32_t shape, ShapeHit& hit) const;
 
     const Scene& m_scene;
-    bool m_usable = false;
     bool m_linear = false;  ///< too few objects: POV-Ray tests them in order, without a hierarchy
     std::vector<Node> m_nodes;
     std::vector<uint32_t> m_children;
     std::vector<uint32_t> m_order;  ///< shapes in the order of the converted scene (m_linear only)
+    /// POV-Ray's box of each mesh object of the converted scene: a mesh2 per material of a
+    /// mesh, and per instance one per mesh2 of its prototype (POV-Ray splits their union).
+    std::vector<Bounds> m_mesh_bounds;
     uint32_t m_root = 0;
 };
 
@@ -96,5 +100,11 @@ private:
 /// single-precision bounding box of the union holds the whole box (pov_writer.cpp): the world
 /// bounds pushed out by 8 to 16 floats' spacing.
 void povray_box_corners(const Transform& to_world, const Vec3& min, const Vec3& max, Vec3& lo, Vec3& hi);
+
+/// The point `whitted convert` writes a mesh2's vertices about, moving it there with
+/// `translate` (pov_writer.cpp): per axis, a float near the middle of the `count` vertices when
+/// they reach 16 or more from the origin on that axis and every vertex minus it is exactly a
+/// float; otherwise 0.
+Vec3 povray_mesh_centre(size_t count, const std::function<Vec3(size_t)>& vertex);
 
 }  // namespace whitted
