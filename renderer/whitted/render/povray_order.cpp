@@ -114,7 +114,8 @@ Bounds box_bounds(const Box& box) {
 }
 
 /// POV-Ray's boxes of the mesh2 objects `whitted convert` writes for `mesh`, one per material
-/// (in the order of the materials' numbers), appended to `out`. A mesh2's box holds its
+/// in the order of the materials' numbers, appended to `out` (the writer orders an OBJ's pieces
+/// by their MTL materials, which validate_scene numbers in the MTL file's order). A mesh2's box holds its
 /// triangles' float vertices (POV-Ray's Mesh::Compute_BBox: the least and greatest coordinate
 /// over its triangles), written about the mesh's centre, then moved there by `translate`,
 /// which recomputes the box as any transform does.
