@@ -540,7 +540,7 @@ int main(int argc, char** argv) {
     // guest's free memory in 2 MiB blocks (virtio-balloon free page reporting), and a huge
     // page is exactly such a block: its first touch is then 512 faults on the host. The
     // 1M-triangle build took 0.37-0.40 s in three runs of five against 0.11 s with ordinary
-    // pages, and no scene rendered faster with them (docs/performance.md, "Huge pages").
+    // pages, and no scene rendered faster with them (docs/performance.md, "Huge pages off again").
     prctl(PR_SET_THP_DISABLE, 1, 0, 0, 0);
     CLI::App app{
         "Whitted: an offline ray tracer for the classic lecture shading model\n"
