@@ -40,7 +40,7 @@ Bounds from_min_max(const double mins[3], const double maxs[3]) {
 
 /// The box around several boxes, grown one at a time from each one's corner and far corner
 /// (corner + size, in double): how POV-Ray encloses a union's children, a node's, and the items
-/// either side of a split.
+/// either side of a split; or around points (a mesh2's vertices).
 struct Around {
     double lo[3] = {bound_huge, bound_huge, bound_huge}, hi[3] = {-bound_huge, -bound_huge, -bound_huge};
 
@@ -49,6 +49,12 @@ struct Around {
             const double lower = double(b.lower[a]), upper = lower + double(b.length[a]);
             if (lower < lo[a]) lo[a] = lower;
             if (upper > hi[a]) hi[a] = upper;
+        }
+    }
+    void add(const Vec3& point) {
+        for (int a = 0; a < 3; ++a) {
+            if (point[a] < lo[a]) lo[a] = point[a];
+            if (point[a] > hi[a]) hi[a] = point[a];
         }
     }
     /// Half its surface area, the split cost's measure.
@@ -136,12 +142,8 @@ void mesh_bounds(const TriangleMesh& mesh, std::vector<Bounds>& out) {
                 ? 0
                 : size_t(std::lower_bound(materials.begin(), materials.end(), mesh.triangle_materials[t]) -
                          materials.begin());
-        Around& around = pieces[piece];
-        for (int k = 0; k < 3; ++k) {
-            const Vec3 v = vertex(mesh.indices[3 * t + k]) - centre;  // exact: povray_mesh_centre
-            for (int a = 0; a < 3; ++a)
-                around.lo[a] = std::min(around.lo[a], v[a]), around.hi[a] = std::max(around.hi[a], v[a]);
-        }
+        for (int k = 0; k < 3; ++k)
+            pieces[piece].add(vertex(mesh.indices[3 * t + k]) - centre);  // exact: povray_mesh_centre
     }
     for (const Around& piece : pieces) {
         Bounds b = piece.bounds();
@@ -298,6 +300,8 @@ Vec3 povray_mesh_centre(size_t count, const std::function<Vec3(size_t)>& vertex)
 PovrayTestOrder::PovrayTestOrder(const Scene& scene) : m_scene(scene) {
     // The converted scene's order: every object where the scene file has it (Scene::objects).
     const size_t spheres = scene.spheres.size(), boxes = scene.boxes.size();
+    // POV-Ray's box of each mesh object of the converted scene, until the leaves hold them.
+    std::vector<Bounds> mesh_boxes;
     {
         // Each kind is already in file order: merge the three lists by object number.
         std::vector<std::pair<uint32_t, uint32_t>> by_object, kind, merged;  // (object, shape)
@@ -312,9 +316,9 @@ PovrayTestOrder::PovrayTestOrder(const Scene& scene) : m_scene(scene) {
         // Then the mesh objects, each after the planes (its pieces numbered in their order).
         const uint32_t first_mesh = uint32_t(spheres + boxes + scene.planes.size());
         for (const TriangleMesh& mesh : scene.meshes) {
-            const size_t before = m_mesh_bounds.size();
-            mesh_bounds(mesh, m_mesh_bounds);
-            for (size_t k = before; k < m_mesh_bounds.size(); ++k)
+            const size_t before = mesh_boxes.size();
+            mesh_bounds(mesh, mesh_boxes);
+            for (size_t k = before; k < mesh_boxes.size(); ++k)
                 merged.emplace_back(mesh.object, uint32_t(first_mesh + k));
         }
         std::vector<std::vector<Bounds>> prototype_pieces(scene.prototypes.size());
@@ -322,8 +326,8 @@ PovrayTestOrder::PovrayTestOrder(const Scene& scene) : m_scene(scene) {
             for (const TriangleMesh& mesh : scene.prototypes[p].meshes) mesh_bounds(mesh, prototype_pieces[p]);
         for (const Instance& instance : scene.instances) {
             for (const Bounds& piece : prototype_pieces[instance.prototype]) {
-                merged.emplace_back(instance.object, uint32_t(first_mesh + m_mesh_bounds.size()));
-                m_mesh_bounds.push_back(placed_bounds(piece, instance.object_to_world));
+                merged.emplace_back(instance.object, uint32_t(first_mesh + mesh_boxes.size()));
+                mesh_boxes.push_back(placed_bounds(piece, instance.object_to_world));
             }
         }
         if (!std::is_sorted(merged.begin(), merged.end())) std::sort(merged.begin(), merged.end());
@@ -351,7 +355,7 @@ PovrayTestOrder::PovrayTestOrder(const Scene& scene) : m_scene(scene) {
         } else if (shape < spheres + boxes + scene.planes.size()) {
             leaf.infinite = true;
         } else {
-            leaf.bounds = m_mesh_bounds[shape - (spheres + boxes + scene.planes.size())];
+            leaf.bounds = mesh_boxes[shape - (spheres + boxes + scene.planes.size())];
         }
         if (leaf.infinite)
             infinite.push_back(uint32_t(m_nodes.size()));
@@ -359,8 +363,7 @@ PovrayTestOrder::PovrayTestOrder(const Scene& scene) : m_scene(scene) {
             finite.push_back({leaf.bounds, uint32_t(m_nodes.size())});
         m_nodes.push_back(leaf);
     }
-    std::vector<uint32_t>().swap(m_order);      // only the order without a hierarchy needs it
-    std::vector<Bounds>().swap(m_mesh_bounds);  // in the leaves now
+    std::vector<uint32_t>().swap(m_order);  // only the order without a hierarchy needs it
     build(finite, infinite);
 }
 

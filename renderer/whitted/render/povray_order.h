@@ -57,7 +57,8 @@ private:
         uint32_t first_child = 0;  ///< in m_children
         uint32_t child_count = 0;  ///< 0: a leaf
         /// A leaf's shape: spheres first, then boxes (index − spheres.size()), then planes, then
-        /// the converted scene's mesh objects (m_mesh_bounds).
+        /// the converted scene's mesh objects (a mesh2 per material of a mesh; per instance one
+        /// per mesh2 of its prototype, POV-Ray splitting their union).
         uint32_t shape = 0;
     };
 
@@ -90,9 +91,6 @@ private:
     std::vector<Node> m_nodes;
     std::vector<uint32_t> m_children;
     std::vector<uint32_t> m_order;  ///< shapes in the order of the converted scene (m_linear only)
-    /// POV-Ray's box of each mesh object of the converted scene: a mesh2 per material of a
-    /// mesh, and per instance one per mesh2 of its prototype (POV-Ray splits their union).
-    std::vector<Bounds> m_mesh_bounds;
     uint32_t m_root = 0;
 };
 
