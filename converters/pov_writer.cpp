@@ -216,6 +216,18 @@ private:
             case ObjectType::box:
                 box(object, to_world);
                 break;
+            case ObjectType::cylinder:
+                // POV-Ray's own cylinder: base, cap, radius, `open` for no end caps.
+                m_out += "cylinder { " + vec(object.base.value) + ", " + vec(object.cap.value) + ", " +
+                         num(object.radius.value) + (object.open.value ? " open" : "") + "\n    " +
+                         texture(material_of(object)) + "\n   " + matrix(to_world) + " }\n";
+                break;
+            case ObjectType::cone:
+                m_out += "cone { " + vec(object.base.value) + ", " + num(object.base_radius.value) + ", " +
+                         vec(object.cap.value) + ", " + num(object.cap_radius.value) +
+                         (object.open.value ? " open" : "") + "\n    " + texture(material_of(object)) + "\n   " +
+                         matrix(to_world) + " }\n";
+                break;
             case ObjectType::plane: {
                 // World-space plane computed exactly as Whitted does; POV's `plane { n, d }` is n·x = d.
                 const Vec3 normal = normalize(to_world.apply_normal(object.normal.value));
@@ -413,10 +425,9 @@ static void refuse_inexpressible(const SceneDescription& d) {
     if (d.min_weight.value != 0)
         refuse(d.min_weight.where, "render.min_weight (a path-weight cut-off) has no exact POV-Ray equivalent");
     const CameraDescription& c = d.camera;
-    if (c.view_height.given && c.type.value == CameraType::perspective)
-        refuse(c.view_height.where,
-               "camera.view_height (a window camera, possibly oblique) is not supported by the "
-               "POV-Ray converter");
+    if (c.view_height.given && c.type.value == CameraType::perspective && c.image_plane_normal.given)
+        refuse(c.image_plane_normal.where,
+               "camera.image_plane_normal (an oblique window camera) has no POV-Ray equivalent");
     std::function<void(const MaterialDescription&)> material = [&](const MaterialDescription& m) {
         if (m.fresnel_ior.given)
             refuse(m.fresnel_ior.where,
@@ -447,7 +458,14 @@ static std::string write_sdl(const SceneDescription& d, const ConvertOptions& op
     o += "background { " + rgb(d.image.background.value * exposure) + " }\n";
 
     const CameraDescription& c = d.camera;
-    if (c.type.value == CameraType::perspective) {
+    if (c.type.value == CameraType::perspective && c.view_height.given) {
+        // The window camera, its window across the view direction: POV-Ray's own vectors, their
+        // lengths the window's size and distance (no `angle`), turned by look_at and sky.
+        o += "camera {\n  perspective\n  location " + vec(c.eye.value) + "\n  right <" + num(-c.view_width.value) +
+             ", 0, 0>\n  up <0, " + num(c.view_height.value) + ", 0>\n  direction <0, 0, " +
+             num(c.projection_distance.value) + ">\n  sky " + vec(c.up.value) + "\n  look_at " + vec(c.look_at.value) +
+             "\n}\n";
+    } else if (c.type.value == CameraType::perspective) {
         // `right -x·W/H` makes POV-Ray's camera right-handed (docs/pov-model.md §4); `angle` is the horizontal fov.
         o += "camera {\n  perspective\n  location " + vec(c.eye.value) + "\n  right <" + num(-aspect) +
              ", 0, 0>\n  up <0, 1, 0>\n  sky " + vec(c.up.value) + "\n  angle " + num(c.fov.value) + "\n  look_at " +

@@ -112,6 +112,17 @@ public:
                 case ObjectType::box:
                     out += in + "min: " + vec3(o.min.value) + "\n" + in + "max: " + vec3(o.max.value) + "\n";
                     break;
+                case ObjectType::cylinder:
+                    out += in + "base: " + vec3(o.base.value) + "\n" + in + "cap: " + vec3(o.cap.value) + "\n" + in +
+                           "radius: " + number(o.radius.value) + "\n";
+                    if (o.open.value) out += in + "open: true\n";
+                    break;
+                case ObjectType::cone:
+                    out += in + "base: " + vec3(o.base.value) + "\n" + in +
+                           "base_radius: " + number(o.base_radius.value) + "\n" + in + "cap: " + vec3(o.cap.value) +
+                           "\n" + in + "cap_radius: " + number(o.cap_radius.value) + "\n";
+                    if (o.open.value) out += in + "open: true\n";
+                    break;
                 case ObjectType::triangle:
                 case ObjectType::mesh:
                     if (o.type == ObjectType::mesh && o.file.given) {

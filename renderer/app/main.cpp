@@ -559,11 +559,12 @@ int main(int argc, char** argv) {
         "docs/distributed.md).\n"
         "Scene format: docs/scene-format.md. Examples: examples/lecture/.\n"
         "Cornell CS4620 course scenes (.xml, with .msh meshes) render and convert directly, with the\n"
-        "course's conventions: docs/course-format.md (its images: --display 'Gamma 2.2').");
+        "course's conventions: docs/course-format.md (its images: --display 'Gamma 2.2').\n"
+        "NFF scenes (.nff, Eric Haines' SPD databases) render, convert and check directly: docs/nff.md.");
 
     RenderArguments render_args;
     CLI::App* render_cmd = app.add_subcommand(
-        "render", "Render a scene file (YAML or JSON, format v1; or a course .xml scene) to an image");
+        "render", "Render a scene file (YAML or JSON, format v1; a course .xml scene; an NFF .nff scene) to an image");
     render_cmd->add_option("scene", render_args.scene, "Scene file")->required()->check(CLI::ExistingFile);
     render_cmd
         ->add_option("-o,--output", render_args.output,
@@ -622,7 +623,7 @@ int main(int argc, char** argv) {
     convert_cmd
         ->add_option("output", convert_output,
                      "Output file; the extension picks the format: .pov = POV-Ray 3.7 (+ a matching .ini), "
-                     ".yaml/.yml = Whitted's own format (e.g. from a course .xml scene)")
+                     ".yaml/.yml = Whitted's own format (e.g. from a course .xml or an NFF .nff scene)")
         ->required();
 
     std::string check_scene;

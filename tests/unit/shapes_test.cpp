@@ -192,6 +192,97 @@ TEST(Box, RotatedBoxNormalFollowsTransform) {
     expect_vec_near(normalize(hit.normal), {1, 0, 0}, 1e-12);
 }
 
+/// A cone along +z from the origin: radius r0 at z = 0, r1 at z = h.
+Cone cone_along_z(double r0, double r1, double h, bool open = false) {
+    Cone cone;
+    cone.base = {0, 0, 0};
+    cone.axis = {0, 0, 1};
+    cone.height = h;
+    cone.base_radius = r0;
+    cone.cap_radius = r1;
+    cone.open = open;
+    return cone;
+}
+
+TEST(Cylinder, SideCapsAndInsideInClosedForm) {
+    const Cone cylinder = cone_along_z(0.5, 0.5, 2);
+    ShapeHit hit;
+    // Across the axis at z = 1: the side at x = 0.5, 3 − 0.5 away, normal +x (times r).
+    ASSERT_TRUE(intersect_cone(cylinder, ray_from({3, 0, 1}, {-1, 0, 0}), t_min, t_max, hit));
+    EXPECT_DOUBLE_EQ(hit.t, 2.5);
+    expect_vec_near(normalize(hit.normal), {1, 0, 0}, 1e-15);
+    // Down the axis from above: the cap at z = 2, normal +z.
+    ASSERT_TRUE(intersect_cone(cylinder, ray_from({0.1, 0.2, 5}, {0, 0, -1}), t_min, t_max, hit));
+    EXPECT_DOUBLE_EQ(hit.t, 3);
+    expect_vec_near(normalize(hit.normal), {0, 0, 1}, 0);
+    // Up from below: the base disc, normal −z.
+    ASSERT_TRUE(intersect_cone(cylinder, ray_from({0, 0, -1}, {0, 0, 1}), t_min, t_max, hit));
+    EXPECT_DOUBLE_EQ(hit.t, 1);
+    expect_vec_near(normalize(hit.normal), {0, 0, -1}, 0);
+    // A slanted ray: x = 3 − 3s/5·..., solved by hand: from (3, 0, 0) toward (−1, 0, 0.25)·k.
+    const Vec3 d = normalize(Vec3(-1, 0, 0.25));
+    ASSERT_TRUE(intersect_cone(cylinder, ray_from({3, 0, 0}, d), t_min, t_max, hit));
+    EXPECT_NEAR(hit.t, 2.5 / -d.x, 1e-14);
+    // Beside it, and past its ends: no hit.
+    EXPECT_FALSE(intersect_cone(cylinder, ray_from({3, 0.51, 1}, {-1, 0, 0}), t_min, t_max, hit));
+    EXPECT_FALSE(intersect_cone(cylinder, ray_from({3, 0, 2.01}, {-1, 0, 0}), t_min, t_max, hit));
+    EXPECT_FALSE(intersect_cone(cylinder, ray_from({0.6, 0, 5}, {0, 0, -1}), t_min, t_max, hit));
+}
+
+TEST(Cylinder, OpenEndsShowTheInsideWall) {
+    const Cone open = cone_along_z(0.5, 0.5, 2, true);
+    ShapeHit hit;
+    // Down the axis: no cap, and the wall is parallel: nothing.
+    EXPECT_FALSE(intersect_cone(open, ray_from({0, 0, 5}, {0, 0, -1}), t_min, t_max, hit));
+    // Into the open top at an angle: the inner wall, on the far side (x = −0.5).
+    const Vec3 d = normalize(Vec3(-1, 0, -1));
+    ASSERT_TRUE(intersect_cone(open, ray_from({0.25, 0, 2.5}, d), t_min, t_max, hit));
+    EXPECT_NEAR(hit.t, 0.75 / -d.x, 1e-14);
+    expect_vec_near(normalize(hit.normal), {-1, 0, 0}, 1e-15);  // outward: Whitted turns it to the ray
+    // Closed, the same ray meets the cap first.
+    ASSERT_TRUE(intersect_cone(cone_along_z(0.5, 0.5, 2), ray_from({0.25, 0, 2.5}, d), t_min, t_max, hit));
+    EXPECT_NEAR(hit.t, 0.5 / -d.z, 1e-14);
+}
+
+TEST(Cone, SlantedSideNormalAndPoint) {
+    // Radius 1 at z = 0 to a point at z = 1: the side is x + z = 1 in the xz plane, normal (1, 0, 1)/√2.
+    const Cone cone = cone_along_z(1, 0, 1);
+    ShapeHit hit;
+    ASSERT_TRUE(intersect_cone(cone, ray_from({3, 0, 0.5}, {-1, 0, 0}), t_min, t_max, hit));
+    EXPECT_DOUBLE_EQ(hit.t, 2.5);
+    expect_vec_near(normalize(hit.normal), normalize(Vec3(1, 0, 1)), 1e-15);
+    // Straight down onto the point: the axis is the normal there.
+    ASSERT_TRUE(intersect_cone(cone, ray_from({0, 0, 3}, {0, 0, -1}), t_min, t_max, hit));
+    EXPECT_DOUBLE_EQ(hit.t, 2);
+    expect_vec_near(normalize(hit.normal), {0, 0, 1}, 0);
+    // A truncated cone wider at the top (cap_radius > base_radius): side at z = 1 is at r = 1.5.
+    const Cone funnel = cone_along_z(0.5, 2.5, 2);
+    ASSERT_TRUE(intersect_cone(funnel, ray_from({4, 0, 1}, {-1, 0, 0}), t_min, t_max, hit));
+    EXPECT_DOUBLE_EQ(hit.t, 2.5);
+    expect_vec_near(normalize(hit.normal), normalize(Vec3(1, 0, -1)), 1e-15);
+    // The other nappe of the double cone (beyond the point) is not part of the cone.
+    EXPECT_FALSE(intersect_cone(cone, ray_from({3, 0, 1.5}, {-1, 0, 0}), t_min, t_max, hit));
+}
+
+TEST(Cone, AnyAxisAndATransformGiveTheSameHits) {
+    // The cylinder along z, turned to lie along x by a rotation, against one built along x.
+    Cone along_x = cone_along_z(0.5, 0.5, 2);
+    along_x.axis = {1, 0, 0};
+    Cone turned = cone_along_z(0.5, 0.5, 2);
+    turned.object_to_world = std::make_shared<const Transform>(Transform::rotate({0, 1, 0}, 90));
+    ShapeHit a, b;
+    ASSERT_TRUE(intersect_cone(along_x, ray_from({1, 3, 0.2}, {0, -1, 0}), t_min, t_max, a));
+    ASSERT_TRUE(intersect_cone(turned, ray_from({1, 3, 0.2}, {0, -1, 0}), t_min, t_max, b));
+    EXPECT_NEAR(a.t, 3 - std::sqrt(0.25 - 0.04), 1e-14);
+    EXPECT_NEAR(b.t, a.t, 1e-14);
+    expect_vec_near(normalize(b.normal), normalize(a.normal), 1e-14);
+    // Bounds: the discs' extents, r·√(1 − w_i²) across each coordinate axis.
+    Vec3 lo, hi;
+    world_bounds(along_x, lo, hi);
+    expect_vec_near(lo, {0, -0.5, -0.5}, 0);
+    expect_vec_near(hi, {2, 0.5, 0.5}, 0);
+}
+
 TEST(Plane, HitAtClosedFormDistance) {
     const Plane plane{{0, -1, 0}, {0, 1, 0}, 0};
     ShapeHit hit;

@@ -263,6 +263,80 @@ Vec3 mesh2_smooth_normal(const Vec3& p1_in, const Vec3& p2_in, const Vec3& p3_in
             n1.z + u * (n2.z - n1.z + v * (n3.z - n2.z))};
 }
 
+namespace {
+
+/// The cone test on a ray already in the cone's own space. With the origin o and direction d
+/// split along the axis (o_s, d_s) and across it (o⊥, d⊥), a point at t is on the side where
+/// |o⊥ + t d⊥| = r0 + k (o_s + t d_s), k = (r1 − r0)/h: the quadratic
+/// (d⊥·d⊥ − k² d_s²) t² + 2 (o⊥·d⊥ − k ρ d_s) t + (o⊥·o⊥ − ρ²) = 0, ρ = r0 + k o_s, whose
+/// roots count where 0 ≤ s ≤ h. The roots are taken in the form that loses no digits to
+/// cancellation (q = −(b + sign(b)·√disc), t = q/a and c/q).
+bool cone_hit(const Cone& cone, const Vec3& origin, const Vec3& direction, double t_min, double t_max, double& t,
+              Vec3& normal) {
+    const Vec3& w = cone.axis;
+    const Vec3 from_base = origin - cone.base;
+    const double o_s = dot(from_base, w), d_s = dot(direction, w);
+    const Vec3 o_across = from_base - w * o_s, d_across = direction - w * d_s;
+    const double k = (cone.cap_radius - cone.base_radius) / cone.height;
+    const double rho = cone.base_radius + k * o_s;
+    const double a = dot(d_across, d_across) - k * k * d_s * d_s;
+    const double half_b = dot(o_across, d_across) - k * rho * d_s;
+    const double c = dot(o_across, o_across) - rho * rho;
+    bool found = false;
+    const auto consider_side = [&](double root) {
+        if (!(root > t_min && root < t_max) || (found && root >= t)) return;
+        const double s = o_s + root * d_s;
+        if (!(s >= 0 && s <= cone.height)) return;
+        t = root, found = true;
+        // The gradient of |p⊥| − r(s), times r(s) = |p⊥| on the surface: no division.
+        const Vec3 across = o_across + d_across * root;
+        normal = across - w * (k * (cone.base_radius + k * s));
+        // The point of a cone to a point: no gradient there; the axis, outward.
+        if (normal.x == 0 && normal.y == 0 && normal.z == 0) normal = w * (s > cone.height / 2 ? 1.0 : -1.0);
+    };
+    if (a != 0) {
+        const double disc = half_b * half_b - a * c;
+        if (disc >= 0) {
+            const double q = -(half_b + std::copysign(std::sqrt(disc), half_b));
+            consider_side(q / a);
+            if (q != 0) consider_side(c / q);
+        }
+    } else if (half_b != 0) {  // along the slant of the cone (or the axis of a cylinder: no root)
+        consider_side(-c / (2 * half_b));
+    }
+    if (!cone.open && d_s != 0) {
+        const auto consider_cap = [&](double s, double radius, double sign) {
+            const double root = (s - o_s) / d_s;
+            if (!(root > t_min && root < t_max) || (found && root >= t)) return;
+            const Vec3 across = o_across + d_across * root;
+            if (!(dot(across, across) <= radius * radius)) return;
+            t = root, found = true;
+            normal = w * sign;
+        };
+        consider_cap(0, cone.base_radius, -1);
+        consider_cap(cone.height, cone.cap_radius, 1);
+    }
+    return found;
+}
+
+}  // namespace
+
+bool intersect_cone(const Cone& cone, const Ray& world_ray, double t_min, double t_max, ShapeHit& hit) {
+    double t;
+    Vec3 normal;
+    if (!cone.object_to_world) {
+        if (!cone_hit(cone, world_ray.origin, world_ray.direction, t_min, t_max, t, normal)) return false;
+        hit.t = t;
+        hit.normal = normal;
+        return true;
+    }
+    const Ray ray = to_object_space(*cone.object_to_world, world_ray);
+    if (!cone_hit(cone, ray.origin, ray.direction, t_min, t_max, t, normal)) return false;
+    hit.t = t;
+    hit.normal = cone.object_to_world->apply_normal(normal);
+    return true;
+}
+
 void world_bounds(const Transform& to_world, const Vec3& lo, const Vec3& hi, Vec3& out_lo, Vec3& out_hi) {
     if (to_world.is_identity()) {
         out_lo = lo, out_hi = hi;
@@ -288,6 +362,17 @@ void world_bounds(const Sphere& sphere, Vec3& lo, Vec3& hi) {
 
 void world_bounds(const Box& box, Vec3& lo, Vec3& hi) {
     world_bounds(transform_of(box.object_to_world), box.min, box.max, lo, hi);
+}
+
+void world_bounds(const Cone& cone, Vec3& lo, Vec3& hi) {
+    // Each end is a disc across the axis: along a coordinate axis e it reaches r·√(1 − (w·e)²).
+    const Vec3& w = cone.axis;
+    const Vec3 reach{std::sqrt(std::max(0.0, 1 - w.x * w.x)), std::sqrt(std::max(0.0, 1 - w.y * w.y)),
+                     std::sqrt(std::max(0.0, 1 - w.z * w.z))};
+    const Vec3 cap = cone.base + w * cone.height;
+    lo = min(cone.base - reach * cone.base_radius, cap - reach * cone.cap_radius);
+    hi = max(cone.base + reach * cone.base_radius, cap + reach * cone.cap_radius);
+    if (cone.object_to_world) world_bounds(*cone.object_to_world, Vec3(lo), Vec3(hi), lo, hi);
 }
 
 }  // namespace whitted

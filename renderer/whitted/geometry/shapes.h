@@ -22,6 +22,10 @@ struct ShapeHit {
 
 bool intersect_sphere(const Sphere& sphere, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
 bool intersect_box(const Box& box, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
+/// The side as a quadric in the cone's own frame (the axis and the plane across it), then the
+/// caps as discs unless the cone is open; the nearest hit. Exact in double: no tolerance but
+/// t_min. The side's normal is the gradient of |p⊥| − r(s), scaled by r(s).
+bool intersect_cone(const Cone& cone, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
 bool intersect_plane(const Plane& plane, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
 /// Möller–Trumbore; the normal is (v1 − v0) × (v2 − v0). `edge_margin` widens the triangle by
 /// that much in barycentric terms (u, v ≥ −margin, u + v ≤ 1 + margin): with a small margin a
@@ -50,9 +54,10 @@ bool intersect_mesh2_triangle(const Vec3& p1, const Vec3& p2, const Vec3& p3, co
 Vec3 mesh2_smooth_normal(const Vec3& p1, const Vec3& p2, const Vec3& p3, const Vec3& n1, const Vec3& n2, const Vec3& n3,
                          const Vec3& point);
 
-/// World-space bounds of a sphere or box (its object-space box pushed through the transform).
+/// World-space bounds of a sphere, box or cone (its object-space box pushed through the transform).
 void world_bounds(const Sphere& sphere, Vec3& lo, Vec3& hi);
 void world_bounds(const Box& box, Vec3& lo, Vec3& hi);
+void world_bounds(const Cone& cone, Vec3& lo, Vec3& hi);
 /// World-space bounds of the axis-aligned box [lo, hi] of an object's space under `to_world`
 /// (the extremes of its eight corners).
 void world_bounds(const Transform& to_world, const Vec3& lo, const Vec3& hi, Vec3& out_lo, Vec3& out_hi);

@@ -23,6 +23,8 @@
 
 #include <sys/mman.h>
 
+#include <tuple>
+
 #include <tbb/blocked_range.h>
 #include <tbb/collaborative_call_once.h>
 #include <tbb/parallel_for.h>
@@ -30,7 +32,7 @@
 namespace whitted {
 namespace {
 
-enum class ShapeKind : uint32_t { triangles, spheres, boxes, instances };
+enum class ShapeKind : uint32_t { triangles, spheres, boxes, cones, instances };
 
 /// A ray taken into an instance's prototype space, in double. The direction is not
 /// renormalised, so t along it is the world t: ranges and distances carry over unchanged.
@@ -90,17 +92,25 @@ struct AnalyticGeometry {
     Vec3 offset;  ///< Embree's coordinates are world minus this (Impl::choose_frame)
 };
 
-/// A sphere's or box's material and object (Scene::objects index + 1).
-std::pair<uint32_t, uint32_t> material_and_object(const AnalyticGeometry& geometry, unsigned prim) {
-    if (geometry.kind == ShapeKind::spheres)
-        return {geometry.scene->spheres[prim].material, geometry.scene->spheres[prim].object};
-    return {geometry.scene->boxes[prim].material, geometry.scene->boxes[prim].object};
+/// A sphere's, box's or cone's material and object (Scene::objects index + 1).
+std::pair<uint32_t, uint32_t> material_and_object(const Scene& scene, ShapeKind kind, unsigned prim) {
+    if (kind == ShapeKind::spheres) return {scene.spheres[prim].material, scene.spheres[prim].object};
+    if (kind == ShapeKind::cones) return {scene.cones[prim].material, scene.cones[prim].object};
+    return {scene.boxes[prim].material, scene.boxes[prim].object};
 }
 
 bool intersect_analytic(const AnalyticGeometry& geometry, unsigned prim, const Ray& ray, double t_max, ShapeHit& hit) {
     if (geometry.kind == ShapeKind::spheres)
         return intersect_sphere(geometry.scene->spheres[prim], ray, ray.t_min, t_max, hit);
+    if (geometry.kind == ShapeKind::cones)
+        return intersect_cone(geometry.scene->cones[prim], ray, ray.t_min, t_max, hit);
     return intersect_box(geometry.scene->boxes[prim], ray, ray.t_min, t_max, hit);
+}
+
+/// Whether Scene::objects number `object` (index + 1) is a cylinder or cone.
+bool is_cone_object(const Scene& scene, uint32_t object) {
+    const ObjectType type = scene.objects[object - 1].type;
+    return type == ObjectType::cylinder || type == ObjectType::cone;
 }
 
 void analytic_bounds(const RTCBoundsFunctionArguments* args) {
@@ -108,6 +118,8 @@ void analytic_bounds(const RTCBoundsFunctionArguments* args) {
     Vec3 lo, hi;
     if (geometry->kind == ShapeKind::spheres)
         world_bounds(geometry->scene->spheres[args->primID], lo, hi);
+    else if (geometry->kind == ShapeKind::cones)
+        world_bounds(geometry->scene->cones[args->primID], lo, hi);
     else
         world_bounds(geometry->scene->boxes[args->primID], lo, hi);
     lo -= geometry->offset;
@@ -138,15 +150,20 @@ void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
         // Up to and including the limit, to see a hit at exactly the t of the one held.
         ShapeHit hit;
         if (!intersect_analytic(*geometry, args->primID, ray, next_up(limit), hit)) continue;
-        const auto [material, object] = material_and_object(*geometry, args->primID);
+        const auto [material, object] = material_and_object(*geometry->scene, geometry->kind, args->primID);
         if (hit.t == limit) {
             // At a triangle's (float) distance, or at the ray's end: the candidate does not win.
             if (limit != context->best_t[id] || !(limit < ray.t_max)) continue;
             // An exact tie with the sphere or box held: overlapping boxes with faces in one
             // plane, or two equal spheres in one place.
             const Vec3& held = context->best_normal[id];
-            if (material == context->best_material[id] && hit.normal.x == held.x && hit.normal.y == held.y &&
-                hit.normal.z == held.z) {
+            // POV-Ray's order (PovrayTestOrder) knows spheres and boxes; a tie with a cone goes,
+            // like a tie that looks the same, to the first object in the file, whatever order
+            // Embree met them in.
+            const bool with_cone =
+                geometry->kind == ShapeKind::cones || is_cone_object(*geometry->scene, context->best_object[id]);
+            if (with_cone || (material == context->best_material[id] && hit.normal.x == held.x &&
+                              hit.normal.y == held.y && hit.normal.z == held.z)) {
                 // The two look the same; which one is kept shows only in the objectId layer:
                 // the first in the file, whatever order Embree met them in (which differs from
                 // one instruction set to another).
@@ -655,6 +672,7 @@ struct Accelerator::Impl {
     std::vector<std::vector<MeshAsPovray>> prototype_povray;
     AnalyticGeometry spheres{ShapeKind::spheres, nullptr, {}};
     AnalyticGeometry boxes{ShapeKind::boxes, nullptr, {}};
+    AnalyticGeometry cones{ShapeKind::cones, nullptr, {}};
     RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;  ///< of the scene and its meshes (build_quality)
     int lane_width = 1;                                  ///< rays per Embree packet call (native_lane_width)
     /// Embree works in float in a frame of its own (choose_frame). Rays, vertices and bounds
@@ -669,7 +687,7 @@ struct Accelerator::Impl {
     mutable std::unique_ptr<PovrayTestOrder> tie_order_data;
 
     Impl(const Scene& s, int threads, const std::string& instruction_set) : scene(s), isa(instruction_set) {
-        spheres.scene = boxes.scene = &scene;
+        spheres.scene = boxes.scene = cones.scene = &scene;
         // Embree gets the render's thread count (--threads): its setting limits the whole
         // process's TBB threads (with threads=1 the render ran at half speed), so the two must
         // agree.
@@ -687,7 +705,7 @@ struct Accelerator::Impl {
         // shadow rays (Impl::intersect, Impl::occluded).
         rtcSetSceneFlags(rtc_scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
         frame = choose_frame();
-        spheres.offset = boxes.offset = frame.offset;
+        spheres.offset = boxes.offset = cones.offset = frame.offset;
         size_t most_triangles = 0;
         for (const TriangleMesh& mesh : scene.meshes) most_triangles = std::max(most_triangles, mesh.triangle_count());
         for (const Prototype& prototype : scene.prototypes)
@@ -708,6 +726,7 @@ struct Accelerator::Impl {
         add_instances();
         if (!scene.spheres.empty()) add_analytic(spheres, scene.spheres.size());
         if (!scene.boxes.empty()) add_analytic(boxes, scene.boxes.size());
+        if (!scene.cones.empty()) add_analytic(cones, scene.cones.size());
         rtcCommitScene(rtc_scene);
         try {
             embree_error.throw_if_failed("while building the BVH");
@@ -737,8 +756,8 @@ struct Accelerator::Impl {
     /// and cost 0.03 s of render, while at 100k the two came out even. The BVH only changes the
     /// order in which candidates are met: those images came out bit-identical.
     RTCBuildQuality build_quality() const {
-        const double primitives =
-            double(scene.triangle_count()) + 0.5 * double(scene.spheres.size() + scene.boxes.size());
+        const double primitives = double(scene.triangle_count()) +
+                                  0.5 * double(scene.spheres.size() + scene.boxes.size() + scene.cones.size());
         const double camera_rays = double(scene.width) * scene.height * scene.samples * scene.samples;
         return primitives > camera_rays / 4 ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM;
     }
@@ -768,6 +787,11 @@ struct Accelerator::Impl {
         for (const Box& box : scene.boxes) {
             Vec3 a, b;
             world_bounds(box, a, b);
+            lo = min(lo, a), hi = max(hi, b);
+        }
+        for (const Cone& cone : scene.cones) {
+            Vec3 a, b;
+            world_bounds(cone, a, b);
             lo = min(lo, a), hi = max(hi, b);
         }
         // An instance's float errors come from Embree's world-space ray (the frame's reach) and
@@ -1021,15 +1045,13 @@ struct Accelerator::Impl {
                 // that t, the one POV-Ray tests first shows (PovrayTestOrder).
                 hit.t = best_t;
                 Vec3 normal = best_normal;
-                bool sphere = kinds[geom] == ShapeKind::spheres;
+                ShapeKind kind = kinds[geom];
                 PovrayTestOrder::Found first;
                 if (tied && tie_order().nearest(ray, first, best_t) && first.hit.t == best_t)
-                    sphere = first.sphere, prim = first.index, normal = first.hit.normal;
+                    kind = first.sphere ? ShapeKind::spheres : ShapeKind::boxes, prim = first.index,
+                    normal = first.hit.normal;
                 out.normal = out.geometric_normal = normalize(normal);
-                if (sphere)
-                    out.material = scene.spheres[prim].material, out.object = scene.spheres[prim].object;
-                else
-                    out.material = scene.boxes[prim].material, out.object = scene.boxes[prim].object;
+                std::tie(out.material, out.object) = material_and_object(scene, kind, prim);
             }
             out.t = hit.t;
             t_max = hit.t;

@@ -114,6 +114,10 @@ struct MaterialDescription {
     /// Given: the mirror weight is Schlick's Fresnel factor F for this index of refraction
     /// instead of km, and the other terms are weighted by 1 − F (the course's "Glazed").
     Located<double> fresnel_ior{0.0};
+    /// Transmission: the weight of the refracted ray, L gains kt·L(t) (Whitted 1980).
+    Located<Color> kt{Color{0.0}};
+    /// The index of refraction inside the surface (outside: 1), for the refracted ray.
+    Located<double> ior{1.0};
 };
 
 /// `material:` on an object: a name from `materials`, or an inline map.
@@ -134,7 +138,7 @@ struct TransformStep {
 
 /// `instance`: a placement of a prototype (SceneDescription::prototypes), declared once and
 /// shared by every placement (docs/scene-format.md §3.8).
-enum class ObjectType { sphere, plane, box, triangle, mesh, group, instance };
+enum class ObjectType { sphere, plane, box, triangle, mesh, group, instance, cylinder, cone };
 
 struct ObjectDescription {
     SourceLocation where;
@@ -163,6 +167,13 @@ struct ObjectDescription {
     // mesh from a file
     Located<std::string> file;  ///< as written in the scene
     std::string file_path;      ///< resolved against the scene file's directory
+    // cylinder (with `radius`) and cone: the centres of the two ends, each end's radius, and
+    // whether the ends are left open (no caps)
+    Located<Vec3> base;
+    Located<Vec3> cap;
+    Located<double> base_radius;
+    Located<double> cap_radius;
+    Located<bool> open{false};
     // group
     std::vector<ObjectDescription> children;
     // instance: the name of an entry in `prototypes`

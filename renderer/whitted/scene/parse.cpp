@@ -7,6 +7,7 @@
 
 #include "whitted/scene/course_xml.h"
 #include "whitted/scene/description.h"
+#include "whitted/scene/nff_file.h"
 #include "whitted/scene/text_checks.h"
 
 #include "whitted/scene/yaml_tree.h"
@@ -73,6 +74,16 @@ std::string describe(const Node& node) {
         default:
             return "nothing";
     }
+}
+
+/// `true` or `false`, unquoted (YAML 1.2's core schema spellings).
+bool parse_boolean(const ParseContext& ctx, const Node& node, const What& what) {
+    if (node.IsScalar() && !node.IsQuoted()) {
+        const std::string_view v = node.scalar_view();
+        if (v == "true" || v == "True" || v == "TRUE") return true;
+        if (v == "false" || v == "False" || v == "FALSE") return false;
+    }
+    ctx.fail(node, what + ": expected true or false, got " + describe(node));
 }
 
 double parse_number(const ParseContext& ctx, const Node& node, const What& what) {
@@ -426,12 +437,14 @@ ObjectDescription parse_object(ParseContext& ctx, const Node& node, const std::s
     if (!node.IsMap()) ctx.fail(node, what + ": expected a map with 'type', got " + describe(node));
     const Node type_node = node["type"];
     if (!type_node)
-        ctx.fail(node, what + ": missing required key 'type' (sphere, plane, box, triangle, mesh, group or instance)");
+        ctx.fail(node, what +
+                           ": missing required key 'type' (sphere, plane, box, cylinder, cone, triangle, mesh, group "
+                           "or instance)");
     ObjectDescription object;
     static const std::vector<std::pair<std::string, ObjectType>> object_types = {
-        {"sphere", ObjectType::sphere},     {"plane", ObjectType::plane}, {"box", ObjectType::box},
-        {"triangle", ObjectType::triangle}, {"mesh", ObjectType::mesh},   {"group", ObjectType::group},
-        {"instance", ObjectType::instance}};
+        {"sphere", ObjectType::sphere},     {"plane", ObjectType::plane},       {"box", ObjectType::box},
+        {"triangle", ObjectType::triangle}, {"mesh", ObjectType::mesh},         {"group", ObjectType::group},
+        {"instance", ObjectType::instance}, {"cylinder", ObjectType::cylinder}, {"cone", ObjectType::cone}};
     object.type = parse_choice<ObjectType>(ctx, type_node, what + ".type", object_types);
     // The keys each type takes: type, transform, material (not for groups), then its own.
     std::array<std::string_view, MapReader::max_keys> keys{"type", "transform"};
@@ -449,6 +462,12 @@ ObjectDescription parse_object(ParseContext& ctx, const Node& node, const std::s
             break;
         case ObjectType::box:
             allow({"min", "max"});
+            break;
+        case ObjectType::cylinder:
+            allow({"base", "cap", "radius", "open"});
+            break;
+        case ObjectType::cone:
+            allow({"base", "base_radius", "cap", "cap_radius", "open"});
             break;
         case ObjectType::triangle:
             allow({"vertices"});
@@ -481,6 +500,19 @@ ObjectDescription parse_object(ParseContext& ctx, const Node& node, const std::s
         case ObjectType::box:
             map.vec3(object.min, "min", true);
             map.vec3(object.max, "max", true);
+            break;
+        case ObjectType::cylinder:
+            map.vec3(object.base, "base", true);
+            map.vec3(object.cap, "cap", true);
+            map.number(object.radius, "radius", true);
+            map.read(object.open, "open", parse_boolean);
+            break;
+        case ObjectType::cone:
+            map.vec3(object.base, "base", true);
+            map.number(object.base_radius, "base_radius", true);
+            map.vec3(object.cap, "cap", true);
+            map.number(object.cap_radius, "cap_radius", true);
+            map.read(object.open, "open", parse_boolean);
             break;
         case ObjectType::triangle: {
             const Node vertices = map.require("vertices");
@@ -670,6 +702,10 @@ const char* to_string(ObjectType type) {
             return "group";
         case ObjectType::instance:
             return "instance";
+        case ObjectType::cylinder:
+            return "cylinder";
+        case ObjectType::cone:
+            return "cone";
     }
     return "object";
 }
@@ -728,7 +764,8 @@ SceneDescription parse_scene_file(const std::string& path, const ObjectSink* sin
             description.objects.clear();
         }
         return description;
-    }  // the Cornell course's XML scenes
+    }                                                          // the Cornell course's XML scenes
+    if (is_nff_path(path)) return parse_nff_file(path, sink);  // Eric Haines' NFF (docs/nff.md)
     // Mapped, not copied; devices, fifos and other files that are not regular files are refused
     // before a byte is read (/dev/urandom would never end).
     // The text is gone through once (or twice, where libyaml reads it again), and nothing read

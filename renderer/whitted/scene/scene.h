@@ -3,7 +3,7 @@
 
 // The validated, renderable scene: every value checked, every transform folded into world
 // space where that is exact (triangles, planes), kept beside the shape where it is not
-// (spheres and boxes stay analytic in their own space).
+// (spheres, boxes and cones stay analytic in their own space).
 
 #include "whitted/core/transform.h"
 #include "whitted/core/vec3.h"
@@ -66,6 +66,20 @@ struct Sphere {
 struct Box {
     SharedTransform object_to_world;  ///< null: the identity
     Vec3 min, max;
+    uint32_t material = 0;
+    uint32_t object = 0;  ///< Scene::objects index + 1
+};
+
+/// A cylinder or cone (docs/scene-format.md §3.9): the side joining a disc of base_radius at
+/// `base` to a disc of cap_radius at `base + height·axis`, with those discs as caps unless
+/// `open`. A cylinder is a cone with equal radii.
+struct Cone {
+    SharedTransform object_to_world;  ///< null: the identity
+    Vec3 base;
+    Vec3 axis;  ///< unit, from the base toward the cap
+    double height = 1;
+    double base_radius = 1, cap_radius = 1;
+    bool open = false;
     uint32_t material = 0;
     uint32_t object = 0;  ///< Scene::objects index + 1
 };
@@ -134,6 +148,7 @@ struct Scene {
     std::vector<std::string> layers;  ///< render.layers: the EXR layers asked for (docs/layers.md)
     std::vector<Sphere> spheres;
     std::vector<Box> boxes;
+    std::vector<Cone> cones;  ///< cylinders and cones
     std::vector<Plane> planes;
     std::vector<TriangleMesh> meshes;
     std::vector<std::string> mesh_files;  ///< the mesh files read, as resolved paths

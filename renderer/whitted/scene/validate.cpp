@@ -140,6 +140,7 @@ public:
         };
         for (Sphere& sphere : m_scene.spheres) renumber(sphere.material);
         for (Box& box : m_scene.boxes) renumber(box.material);
+        for (Cone& cone : m_scene.cones) renumber(cone.material);
         for (Plane& plane : m_scene.planes) renumber(plane.material);
         for (TriangleMesh& mesh : m_scene.meshes) renumber_mesh(mesh);
         for (Prototype& prototype : m_scene.prototypes)
@@ -269,6 +270,10 @@ private:
                 m_scene.boxes.push_back({shared(to_world), lo, hi, resolve_material(object), add_id(object)});
                 break;
             }
+            case ObjectType::cylinder:
+            case ObjectType::cone:
+                add_cone(object, to_world);
+                break;
             case ObjectType::triangle: {
                 TriangleMesh mesh;
                 mesh.material = resolve_material(object);
@@ -288,6 +293,35 @@ private:
                 for (const auto& child : object.children) add_object(child, to_world);
                 break;
         }
+    }
+
+    /// A cylinder is a cone with equal radii (docs/scene-format.md §3.9).
+    void add_cone(const ObjectDescription& object, const Transform& to_world) {
+        const bool cylinder = object.type == ObjectType::cylinder;
+        const std::string kind = cylinder ? "cylinder" : "cone";
+        const Located<double>& base_radius = cylinder ? object.radius : object.base_radius;
+        const Located<double>& cap_radius = cylinder ? object.radius : object.cap_radius;
+        if (!(base_radius.value >= 0))
+            fail(base_radius.where, kind + (cylinder ? ".radius must be > 0" : ".base_radius must be >= 0"));
+        if (!(cap_radius.value >= 0)) fail(cap_radius.where, kind + ".cap_radius must be >= 0");
+        if (!(base_radius.value > 0 || cap_radius.value > 0))
+            fail(cylinder ? object.radius.where : object.cap_radius.where,
+                 kind + (cylinder ? ".radius must be > 0" : ": base_radius and cap_radius must not both be 0"));
+        const Vec3 axis = object.cap.value - object.base.value;
+        const double height = length(axis);
+        if (!(height > 0 && std::isfinite(height)))
+            fail(object.cap.where, kind + ": base and cap must be different points (at a finite distance)");
+        Cone cone;
+        cone.object_to_world = shared(to_world);
+        cone.base = object.base.value;
+        cone.axis = axis / height;
+        cone.height = height;
+        cone.base_radius = base_radius.value;
+        cone.cap_radius = cap_radius.value;
+        cone.open = object.open.value;
+        cone.material = resolve_material(object);
+        cone.object = add_id(object);
+        m_scene.cones.push_back(std::move(cone));
     }
 
     /// The instance's material now (a provisional number, as every object's), its prototype in
