@@ -75,8 +75,31 @@ std::string mirror(const Color& km) {
     return is_zero(km) ? "" : " reflection { " + rgb(km) + " }";
 }
 
+/// A transmitting material (kt, docs/pov-model.md §5) as three layers (top first below, written
+/// bottom first) over an interior of index ior, with t1 = t2 = 1/2. POV-Ray weights a layer's ambient and diffuse by
+/// its opacity (1 − filter − transmit) and by the filter of the layers above (the product of their filter·colour +
+/// transmit), its highlight by that filter only, and traces the refracted ray with the product over all layers, which
+/// also filters shadow rays:
+///   L1 white at transmit t1, ambient ka/(1 − t1), the highlight ks and the mirror km;
+///   L2 kd/(t1·(1 − t2)) at transmit t2: the diffuse term;
+///   L3 a pure filter kt/(t1·t2), which makes the product kt.
+/// Needs a grey ks (the converter refuses a coloured one with kt) and adc_bailout 0.
+std::string transmitting_texture(const Material& m) {
+    constexpr double t1 = 0.5, t2 = 0.5;
+    // POV-Ray lays each texture statement over the ones before it: bottom layer first.
+    return "texture { pigment { rgbf <" + num(m.kt.x / (t1 * t2)) + ", " + num(m.kt.y / (t1 * t2)) + ", " +
+           num(m.kt.z / (t1 * t2)) + ", 1> } finish { ambient 0 diffuse 0 specular 0 phong 0 } }\n" +
+           "    texture { pigment { rgbt <" + num(m.kd.x / (t1 * (1 - t2))) + ", " + num(m.kd.y / (t1 * (1 - t2))) +
+           ", " + num(m.kd.z / (t1 * (1 - t2))) + ", " + num(t2) +
+           "> } finish { ambient 0 diffuse 1 brilliance 1 specular 0 phong 0 } }\n" +
+           "    texture { pigment { rgbt <1, 1, 1, " + num(t1) + "> } finish { ambient " + rgb(m.ka / (1 - t1)) +
+           " diffuse 0 " + highlight(m.highlight, m.ks.x, m.p) + mirror(m.km) + " } }\n" + "    interior { ior " +
+           num(m.ior) + " }";
+}
+
 /// The lecture's material as POV-Ray texture(s).
 std::string texture(const Material& m) {
+    if (!is_zero(m.kt)) return transmitting_texture(m);
     // Recipe A (docs/pov-model.md §1a): one texture. POV multiplies ambient and diffuse by the
     // pigment, not the highlight, so it is exact when ks is grey and kd_c > 0 wherever ka_c > 0.
     bool single_texture_exact = is_grey(m.ks);
@@ -191,7 +214,10 @@ private:
     }
 
     static Material to_material(const MaterialDescription& d) {
-        return {d.ka.value, d.kd.value, d.ks.value, d.p.value, d.km.value, d.highlight.value};
+        Material m{d.ka.value, d.kd.value, d.ks.value, d.p.value, d.km.value, d.highlight.value};
+        m.kt = d.kt.value;
+        m.ior = d.ior.value;
+        return m;
     }
 
     /// In a prototype a mesh may leave its material to the instances.
@@ -382,7 +408,10 @@ double radiance_upper_bound(const SceneDescription& d) {
     double local = 0, mirror = 0;
     for (const auto& m : materials) {
         local = std::max(local, max_channel(m.ka.value * d.ambient.value + (m.kd.value + m.ks.value) * light_sum));
-        mirror = std::max(mirror, max_channel(m.km.value));
+        // Where a ray is both reflected and refracted, both paths may come back at the bound;
+        // at total internal reflection POV-Ray brings the light back with weight 1.
+        mirror = std::max(mirror, is_zero(m.kt.value) ? max_channel(m.km.value)
+                                                      : std::max(1.0, max_channel(m.km.value + m.kt.value)));
     }
     // Meshes from files bring their own MTL materials; without reading them, assume the worst.
     std::function<bool(const std::vector<ObjectDescription>&)> has_mtl = [&](const auto& objects) {
@@ -429,6 +458,10 @@ static void refuse_inexpressible(const SceneDescription& d) {
         refuse(c.image_plane_normal.where,
                "camera.image_plane_normal (an oblique window camera) has no POV-Ray equivalent");
     std::function<void(const MaterialDescription&)> material = [&](const MaterialDescription& m) {
+        if (!is_zero(m.kt.value) && !is_grey(m.ks.value))
+            refuse(m.ks.where,
+                   "a coloured ks on a transmitting material (kt): POV-Ray's layered texture for kt "
+                   "gives a grey highlight only");
         if (m.fresnel_ior.given)
             refuse(m.fresnel_ior.where,
                    "fresnel_ior (Schlick-weighted mirror over a (1 - F)-weighted substrate) has "

@@ -47,6 +47,8 @@ std::string material_map(const MaterialDescription& m) {
         out += ", fresnel_ior: " + number(m.fresnel_ior.value);
     else
         out += ", km: " + vec3(m.km.value);
+    if (!is_zero(m.kt.value)) out += ", kt: " + vec3(m.kt.value);
+    if (m.ior.given) out += ", ior: " + number(m.ior.value);
     out += std::string(", highlight: ") + (m.highlight.value == Highlight::blinn ? "blinn" : "phong") + " }";
     return out;
 }

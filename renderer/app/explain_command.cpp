@@ -103,8 +103,10 @@ void print_text(const Scene& scene, const std::string& path, const PixelExplanat
                     sample.sample / n, n, n);
         for (const ExplainedSegment& s : sample.segments) {
             std::printf("  segment %d: %s from %s along %s, t in (%s, %s), weight %s\n", s.level,
-                        s.level == 0 ? "camera ray" : "mirror ray", vec(s.ray.origin).c_str(),
-                        vec(s.ray.direction).c_str(), fmt::format("{}", s.ray.t_min).c_str(),
+                        s.level == 0       ? "camera ray"
+                        : s.refracted_path ? "refracted ray"
+                                           : "mirror ray",
+                        vec(s.ray.origin).c_str(), vec(s.ray.direction).c_str(), fmt::format("{}", s.ray.t_min).c_str(),
                         fmt::format("{}", s.ray.t_max).c_str(), vec(s.weight).c_str());
             if (!s.hit) {
                 std::printf("    miss: weight*background = %s*%s = %s\n", vec(s.weight).c_str(),
@@ -151,7 +153,12 @@ void print_text(const Scene& scene, const std::string& path, const PixelExplanat
                                 fmt::format("{}", t.shadow_ray.t_min).c_str(),
                                 fmt::format("{}", t.shadow_ray.t_max).c_str());
                 }
-                const Color intensity = scene.lights[l.light].intensity;
+                // Through transmitting surfaces the light arrives as I times their kt (the filter).
+                const Color intensity = scene.lights[l.light].intensity * t.filter;
+                if (!(t.filter == Color(1.0)))
+                    std::printf("      through transmitting surfaces: I*filter = %s*%s = %s\n",
+                                vec(scene.lights[l.light].intensity).c_str(), vec(t.filter).c_str(),
+                                vec(intensity).c_str());
                 std::printf("      diffuse   kd*I*(n.l) = %s*%s*%s = %s\n", vec(m.kd).c_str(), vec(intensity).c_str(),
                             fmt::format("{}", t.n_dot_l).c_str(), vec(t.diffuse).c_str());
                 std::printf("      specular  ks*I*lobe = %s*%s*%s = %s\n", vec(m.ks).c_str(), vec(intensity).c_str(),
@@ -166,6 +173,17 @@ void print_text(const Scene& scene, const std::string& path, const PixelExplanat
             else if (!is_zero(m.km))
                 std::printf("    mirror: km = %s, but max depth %d is reached: L(r) = 0\n", vec(m.km).c_str(),
                             scene.max_depth);
+            if (s.transmitted)
+                std::printf(
+                    "    refracted: kt = %s, ior = %s, t = %s; its weight = weight*kt = %s (its segments come "
+                    "next, then the mirror ray's)\n",
+                    vec(m.kt).c_str(), fmt::format("{}", m.ior).c_str(), vec(s.refracted_ray.direction).c_str(),
+                    vec(s.refracted_weight).c_str());
+            else if (!is_zero(m.kt) && s.mirrored && s.mirror_weight == s.weight)
+                std::printf(
+                    "    refracted: kt = %s, ior = %s: total internal reflection, the mirror ray carries "
+                    "the light with weight 1\n",
+                    vec(m.kt).c_str(), fmt::format("{}", m.ior).c_str());
         }
         std::printf("  L = sum of the weighted terms above, in order = %s\n", vec(sample.radiance).c_str());
     }
@@ -243,6 +261,11 @@ nlohmann::json to_json(const Scene& scene, const std::string& path, const PixelE
             j["mirror"] = s.mirrored
                               ? json{{"km", jvec(m.km)}, {"ray", jray(s.mirror_ray)}, {"weight", jvec(s.mirror_weight)}}
                               : json(nullptr);
+            j["refracted"] = s.transmitted ? json{{"kt", jvec(m.kt)},
+                                                  {"ior", m.ior},
+                                                  {"ray", jray(s.refracted_ray)},
+                                                  {"weight", jvec(s.refracted_weight)}}
+                                           : json(nullptr);
             segments.push_back(j);
         }
         samples.push_back({{"sample", sample.sample}, {"segments", segments}, {"radiance", jvec(sample.radiance)}});

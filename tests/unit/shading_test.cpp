@@ -205,3 +205,138 @@ TEST(Shading, MissGivesBackgroundAndMaxDepthOneHasNoMirror) {
 
 }  // namespace
 }  // namespace whitted
+
+// --- Refraction (Whitted 1980's transmitted ray): kt·L(t), t by Snell's law ---
+
+namespace whitted {
+namespace {
+
+/// Records the rays the shading sends on, lane 0 only.
+struct RecordedRays final : PathObserver {
+    struct Sent {
+        int level;
+        Ray ray;
+        Color weight;
+    };
+    std::vector<Sent> mirrors, refracted;
+    void miss(int, int, const Ray&, const Color&, const Color&) override {}
+    void hit(int, int, const Ray&, const SurfaceHit&, const Vec3&) override {}
+    void ambient(int, int, const Color&) override {}
+    void light(int, int, size_t, const LightTerms&) override {}
+    void local(int, int, const Color&, const Color&, const Color&) override {}
+    void mirror(int, int level, const Ray& r, const Color& w) override { mirrors.push_back({level, r, w}); }
+    void transmitted(int, int level, const Ray& r, const Color& w) override { refracted.push_back({level, r, w}); }
+};
+
+Material glass(double ior, const Color& kt, const Color& km = Color(0.0)) {
+    Material m{Color(0.0), Color(0.0), Color(0.0), 1, km, Highlight::blinn};
+    m.kt = kt;
+    m.ior = ior;
+    return m;
+}
+
+/// A scene of boxes (material 0 each) and nothing else.
+Scene box_scene(const std::vector<Box>& boxes, const std::vector<Material>& materials) {
+    Scene scene;
+    scene.width = scene.height = 1;
+    scene.max_depth = 6;
+    scene.ambient = Color(1.0);
+    scene.materials = materials;
+    scene.boxes = boxes;
+    for (size_t i = 0; i < boxes.size(); ++i) {
+        scene.boxes[i].object = uint32_t(i + 1);
+        scene.objects.push_back({ObjectType::box, {}});
+    }
+    return scene;
+}
+
+RecordedRays record(const Scene& scene, const Ray& ray) {
+    const Accelerator accelerator(scene);
+    const LectureShading shading(scene, accelerator);
+    RecordedRays recorded;
+    RayCounts counts;
+    Color radiance;
+    shading.trace_packet(&ray, 1, 0, &radiance, counts, recorded);
+    return recorded;
+}
+
+}  // namespace
+
+TEST(Refraction, ASlabShiftsARayByTheTextbookAmount) {
+    // A slab 0 ≤ y ≤ 1 of index 1.5, met at θ = 50° from its normal: inside the ray runs at θ'
+    // with sin θ' = sin θ / 1.5, and leaves parallel to where it came from, shifted sideways by
+    // d·sin(θ − θ')/cos θ'.
+    const double eta = 1.5, theta = 50 * std::numbers::pi / 180;
+    const Scene scene = box_scene({{nullptr, {-50, 0, -50}, {50, 1, 50}, 0, 0}}, {glass(eta, Color(1.0))});
+    const Vec3 d{std::sin(theta), -std::cos(theta), 0};
+    const Ray ray{Vec3{0, 3, 0} - d * 1.0, d, 1e-4, 1e7};
+    const RecordedRays recorded = record(scene, ray);
+    ASSERT_EQ(recorded.refracted.size(), 2u);  // in through the top, out through the bottom
+    const double theta_inside = std::asin(std::sin(theta) / eta);
+    const Ray& inside = recorded.refracted[0].ray;
+    EXPECT_NEAR(inside.direction.x, std::sin(theta_inside), 1e-14);
+    EXPECT_NEAR(inside.direction.y, -std::cos(theta_inside), 1e-14);
+    const Ray& out = recorded.refracted[1].ray;
+    EXPECT_NEAR(out.direction.x, d.x, 1e-14);
+    EXPECT_NEAR(out.direction.y, d.y, 1e-14);
+    // The distance between the line it left on and the line it came on.
+    const Vec3 offset = out.origin - ray.origin;
+    const double shift = length(offset - d * dot(offset, d));
+    EXPECT_NEAR(shift, 1.0 * std::sin(theta - theta_inside) / std::cos(theta_inside), 1e-13);
+    EXPECT_EQ(recorded.refracted[0].weight, Color(1.0));
+}
+
+TEST(Refraction, AnIndexOfOneLeavesTheImageUnchanged) {
+    // A clear ball of index 1 over a lit floor: every pixel as without it (its kt = 1 lets
+    // camera and shadow rays through unbent and undimmed).
+    Scene with = floor_scene(material(Color(0.1), Color(0.7, 0.5, 0.3), Color(0.0), 1));
+    with.lights = {point_light({2, 4, 1}, Color(0.9))};
+    Scene without = with;
+    with.materials.push_back(glass(1.0, Color(1.0)));
+    with.spheres = {{nullptr, {0, 0.6, 0}, 0.5, 1, 2}};
+    with.objects = {{ObjectType::plane, {}}, {ObjectType::sphere, {}}};
+    without.objects = {{ObjectType::plane, {}}};
+    with.planes[0].object = without.planes[0].object = 1;
+    for (const Vec3 target : {Vec3{0, 0, 0}, Vec3{0.3, 0, -0.2}, Vec3{-0.4, 0, 0.1}, Vec3{0.2, 0.6, 0.1}})
+        expect_color_near(trace_from(with, {0, 3, 3}, target), trace_from(without, {0, 3, 3}, target), 1e-12);
+}
+
+TEST(Refraction, BeyondTheCriticalAngleTheLightComesBackAlongTheMirror) {
+    // Into the top of a tall glass box (index 1.5) at 80°: inside, the ray meets a side at 49°
+    // from its normal, beyond the critical angle asin(1/1.5) = 41.8°: no refracted ray there,
+    // and the mirror ray carries the path on with weight 1 in place of km (POV-Ray's rule).
+    const double theta = 80 * std::numbers::pi / 180;
+    const Color kt(0.6, 0.7, 0.8), km(0.1);
+    const Scene scene = box_scene({{nullptr, {-1, -10, -50}, {1, 0, 50}, 0, 0}}, {glass(1.5, kt, km)});
+    const Vec3 d{std::sin(theta), -std::cos(theta), 0};
+    const RecordedRays recorded = record(scene, {Vec3{-0.5, 0, 0} - d * 2.0, d, 1e-4, 1e7});
+    ASSERT_GE(recorded.refracted.size(), 1u);
+    EXPECT_EQ(recorded.refracted[0].level, 0);
+    EXPECT_EQ(recorded.refracted[0].weight, kt);
+    // The first mirror ray is the top's own (weight km); the next, at the side, is the total
+    // internal reflection: level 1, weight kt·1, and no refracted ray at level 1.
+    ASSERT_GE(recorded.mirrors.size(), 2u);
+    EXPECT_EQ(recorded.mirrors[0].weight, km);
+    EXPECT_EQ(recorded.mirrors[1].level, 1);
+    EXPECT_EQ(recorded.mirrors[1].weight, kt);
+    const double sin_inside = std::sin(theta) / 1.5, cos_inside = std::sqrt(1 - sin_inside * sin_inside);
+    EXPECT_NEAR(recorded.mirrors[1].ray.direction.x, -sin_inside, 1e-14);  // mirrored off the side x = 1
+    EXPECT_NEAR(recorded.mirrors[1].ray.direction.y, -cos_inside, 1e-14);
+    for (const auto& sent : recorded.refracted) EXPECT_NE(sent.level, 1);
+}
+
+TEST(Refraction, AShadowThroughGlassIsTheLightTimesKtAtEachFace) {
+    // A floor under a glass sheet (index 1: no bending), the light straight above: the sheet's
+    // two faces each multiply the light by kt.
+    const Color kt(0.5, 0.25, 1.0), kd(0.8, 0.6, 0.4);
+    Scene scene = floor_scene(material(Color(0.0), kd, Color(0.0), 1));
+    scene.materials.push_back(glass(1.0, kt));
+    scene.boxes = {{nullptr, {-1, 1, -1}, {1, 1.2, 1}, 1, 2}};
+    scene.objects = {{ObjectType::plane, {}}, {ObjectType::box, {}}};
+    scene.planes[0].object = 1;
+    scene.lights = {point_light({0, 5, 0}, Color(1.0))};
+    // Seen from the side, under the sheet: n·l = 1.
+    expect_color_near(trace_from(scene, {3, 0.5, 0}, {0, 0, 0}), kd * kt * kt, 1e-15);
+}
+
+}  // namespace whitted

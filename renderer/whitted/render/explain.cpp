@@ -19,14 +19,16 @@ public:
 
     void miss(int lane, int level, const Ray& ray, const Color& weight, const Color& seen) override {
         if (m_sample[lane] < 0) return;
+        const bool refracted = next_weight(lane).second;
         ExplainedSegment& segment = begin(lane, level, ray, weight);
+        segment.refracted_path = refracted;
         segment.seen = seen;
     }
     void hit(int lane, int level, const Ray& ray, const SurfaceHit& hit, const Vec3& normal) override {
         if (m_sample[lane] < 0) return;
-        const Color weight =
-            m_samples[lane].segments.empty() ? Color(1.0) : m_samples[lane].segments.back().mirror_weight;
+        const auto [weight, refracted] = next_weight(lane);
         ExplainedSegment& segment = begin(lane, level, ray, weight);
+        segment.refracted_path = refracted;
         segment.hit = true;
         segment.surface = hit;
         segment.normal = normal;
@@ -54,9 +56,27 @@ public:
         segment.mirrored = true;
         segment.mirror_ray = mirror_ray;
         segment.mirror_weight = weight;
+        m_pending[size_t(lane)].emplace_back(weight, false);
+    }
+    void transmitted(int lane, int, const Ray& refracted_ray, const Color& weight) override {
+        if (m_sample[lane] < 0) return;
+        ExplainedSegment& segment = m_samples[lane].segments.back();
+        segment.transmitted = true;
+        segment.refracted_ray = refracted_ray;
+        segment.refracted_weight = weight;
+        m_pending[size_t(lane)].emplace_back(weight, true);
     }
 
 private:
+    /// The weight of the segment that starts now: paths are traced depth first, so the rays
+    /// announced (mirror, then refracted) start their segments last announced, first.
+    std::pair<Color, bool> next_weight(int lane) {
+        std::vector<std::pair<Color, bool>>& pending = m_pending[size_t(lane)];
+        if (pending.empty()) return {Color(1.0), false};
+        const std::pair<Color, bool> next = pending.back();
+        pending.pop_back();
+        return next;
+    }
     ExplainedSegment& begin(int lane, int level, const Ray& ray, const Color& weight) {
         ExplainedSegment segment;
         segment.level = level;
@@ -69,6 +89,9 @@ private:
     const Accelerator& m_accelerator;
     const std::vector<int>& m_sample;
     std::vector<ExplainedSample> m_samples;
+    /// Per lane, the rays announced and not yet started: their weight, and whether refracted.
+    std::vector<std::vector<std::pair<Color, bool>>> m_pending =
+        std::vector<std::vector<std::pair<Color, bool>>>(m_samples.size());
 };
 
 /// Both observers at once: the segments and the layers of the same trace.
@@ -92,6 +115,9 @@ public:
     }
     void mirror(int lane, int level, const Ray& r, const Color& w) override {
         m_a.mirror(lane, level, r, w), m_b.mirror(lane, level, r, w);
+    }
+    void transmitted(int lane, int level, const Ray& r, const Color& w) override {
+        m_a.transmitted(lane, level, r, w), m_b.transmitted(lane, level, r, w);
     }
 
 private:

@@ -22,9 +22,10 @@ struct ExplainedLight {
 
 /// One path segment: the ray, then its hit and the terms there, or its miss.
 struct ExplainedSegment {
-    int level = 0;  ///< 0 = the camera ray
+    int level = 0;                ///< 0 = the camera ray
+    bool refracted_path = false;  ///< the segment's ray is a refracted ray (else camera or mirror)
     Ray ray;
-    Color weight;  ///< the product of the km met before this segment
+    Color weight;  ///< the product of the km (and kt) met before this segment
     bool hit = false;
     Color seen;  ///< a miss: weight·background
     SurfaceHit surface;
@@ -34,7 +35,10 @@ struct ExplainedSegment {
     Color local, added;  ///< local = ka·Ia + Σ(diffuse + specular); added = weight·local
     bool mirrored = false;
     Ray mirror_ray;
-    Color mirror_weight;  ///< weight·km, the next segment's weight
+    Color mirror_weight;  ///< weight·km (1 at total internal reflection), the mirror segment's weight
+    bool transmitted = false;
+    Ray refracted_ray;
+    Color refracted_weight;  ///< weight·kt, the refracted segment's weight (its segments come first)
 };
 
 struct ExplainedSample {

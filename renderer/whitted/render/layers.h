@@ -22,7 +22,7 @@ enum class Layer : uint32_t {
     ambient,     ///< ka·Ia at the first hit
     diffuse,     ///< Σ_i kd·I_i·max(0, n·l_i) at the first hit, over the unshadowed lights
     specular,    ///< Σ_i ks·I_i·max(0, n·h_i)^p at the first hit
-    mirror,      ///< km·L(r): everything the first hit's mirror ray brings back, weighted
+    mirror,      ///< km·L(r) + kt·L(t): everything the first hit's mirror and refracted rays bring back, weighted
     background,  ///< the background colour where the camera ray misses
     lights,      ///< light<k>: light k's diffuse + specular at the first hit
     N,           ///< shading normal at the first hit, turned toward the camera ray
@@ -79,6 +79,7 @@ public:
     void light(int lane, int level, size_t light, const LightTerms& terms) override;
     void local(int lane, int level, const Color& weight, const Color& local, const Color& added) override;
     void mirror(int, int, const Ray&, const Color&) override {}
+    void transmitted(int, int, const Ray&, const Color&) override {}
 
 private:
     const Scene& m_scene;

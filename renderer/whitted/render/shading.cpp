@@ -4,6 +4,7 @@
 #include "whitted/core/packet_array.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace whitted {
@@ -68,19 +69,84 @@ struct NoObserver {
     void light(int, int, size_t, const LightTerms&) {}
     void local(int, int, const Color&, const Color&, const Color&) {}
     void mirror(int, int, const Ray&, const Color&) {}
+    void transmitted(int, int, const Ray&, const Color&) {}
+    NoObserver for_lane(int) const { return {}; }
 };
 /// PathObserver behind the same interface, with `watching` for what only it needs computed.
+/// A refracted ray's path is traced as a packet of one lane of its own: `lane`, when set, is
+/// the lane of the packet that path belongs to.
 struct Watching {
     static constexpr bool watching = true;
     PathObserver& to;
-    void miss(int i, int level, const Ray& r, const Color& w, const Color& seen) { to.miss(i, level, r, w, seen); }
-    void hit(int i, int level, const Ray& r, const SurfaceHit& h, const Vec3& n) { to.hit(i, level, r, h, n); }
-    void ambient(int i, int level, const Color& a) { to.ambient(i, level, a); }
-    void light(int i, int level, size_t k, const LightTerms& t) { to.light(i, level, k, t); }
-    void local(int i, int level, const Color& w, const Color& l, const Color& a) { to.local(i, level, w, l, a); }
-    void mirror(int i, int level, const Ray& r, const Color& w) { to.mirror(i, level, r, w); }
+    int lane = -1;
+    int at(int i) const { return lane >= 0 ? lane : i; }
+    void miss(int i, int level, const Ray& r, const Color& w, const Color& seen) { to.miss(at(i), level, r, w, seen); }
+    void hit(int i, int level, const Ray& r, const SurfaceHit& h, const Vec3& n) { to.hit(at(i), level, r, h, n); }
+    void ambient(int i, int level, const Color& a) { to.ambient(at(i), level, a); }
+    void light(int i, int level, size_t k, const LightTerms& t) { to.light(at(i), level, k, t); }
+    void local(int i, int level, const Color& w, const Color& l, const Color& a) { to.local(at(i), level, w, l, a); }
+    void mirror(int i, int level, const Ray& r, const Color& w) { to.mirror(at(i), level, r, w); }
+    void transmitted(int i, int level, const Ray& r, const Color& w) { to.transmitted(at(i), level, r, w); }
+    Watching for_lane(int i) const { return {to, at(i)}; }
 };
 }  // namespace
+
+Color LectureShading::shadow_filter(Ray shadow_ray) const {
+    // POV-Ray's walk: each surface met multiplies the light by its kt, and the search goes on
+    // from shadow_epsilon past it; an opaque one ends it.
+    Color filter(1.0);
+    SurfaceHit hit;
+    while (shadow_ray.t_max > shadow_ray.t_min && m_accelerator.intersect(shadow_ray, hit)) {
+        const Color& kt = m_scene.materials[hit.material].kt;
+        if (is_zero(kt)) return Color(0.0);
+        filter = filter * kt;
+        shadow_ray.t_min = hit.t + ray_limits::shadow_epsilon;
+    }
+    return filter;
+}
+
+bool LectureShading::refract(const Ray& ray, const SurfaceHit& hit, const Vec3& normal, Interiors& interiors,
+                             Vec3& direction) const {
+    // η = n_from / n_to from the objects the ray is inside, as POV-Ray 3.7 keeps them: entering
+    // from outside, leaving the innermost object, leaving one of two overlapping objects (their
+    // overlap counts as the later one's: η = 1), or entering an object inside another.
+    const uint32_t object = hit.object;
+    const double ior = m_scene.materials[hit.material].ior;
+    double eta;
+    const auto inside =
+        std::find_if(interiors.begin(), interiors.end(), [object](const auto& entry) { return entry.first == object; });
+    if (interiors.empty()) {
+        eta = 1.0 / ior;
+        interiors.emplace_back(object, ior);
+    } else if (interiors.back().first == object) {
+        const double leaving = interiors.back().second;
+        interiors.pop_back();
+        eta = leaving / (interiors.empty() ? 1.0 : interiors.back().second);
+    } else if (inside != interiors.end()) {
+        interiors.erase(inside);
+        eta = 1.0;
+    } else {
+        eta = interiors.back().second / ior;
+        interiors.emplace_back(object, ior);
+    }
+    // The same medium on both sides: the ray goes on unbent.
+    if (std::fabs(eta - 1.0) < 1e-10) {
+        direction = ray.direction;
+        return true;
+    }
+    // Snell's law in Heckbert's form, with n the normal on the side the ray comes from and
+    // c = −d·n > 0: t = η d + (η c − √(1 − η²(1 − c²))) n; no root is total internal reflection.
+    double c = dot(ray.direction, normal);
+    Vec3 toward = normal;
+    if (c <= 0)
+        c = -c;
+    else
+        toward = -normal;
+    const double k = 1.0 + eta * eta * (c * c - 1.0);
+    if (k < 0) return false;
+    direction = normalize(ray.direction * eta + toward * (eta * c - std::sqrt(k)));
+    return true;
+}
 
 void LectureShading::direct_lighting(const SurfaceHit* hits, const Ray* rays, const bool* active, int count,
                                      Color* local, Vec3* normal, RayCounts& counts) const {
@@ -141,7 +207,19 @@ void LectureShading::direct_lighting_with(const SurfaceHit* hits, const Ray* ray
             query[i] = shadow_rays[i].t_max > shadow_rays[i].t_min;  // else the light is on the surface: unblocked
             counts.shadow += query[i];
         }
-        m_accelerator.occluded_packet(shadow_rays.data(), query, count, blocked);
+        // With transmitting surfaces in the scene a shadow ray is a walk (shadow_filter), else a
+        // plain occlusion test.
+        PacketArray<Color, packet_size> filter;
+        if (m_transmits) {
+            for (int i = 0; i < count; ++i) {
+                filter[i] = Color(1.0);
+                if (!active[i] || !query[i]) continue;
+                filter[i] = shadow_filter(shadow_rays[i]);
+                blocked[i] = is_zero(filter[i]);
+            }
+        } else {
+            m_accelerator.occluded_packet(shadow_rays.data(), query, count, blocked);
+        }
         for (int i = 0; i < count; ++i) {
             if constexpr (Observer::watching) {
                 if (active[i] && !(lit[i] && !(query[i] && blocked[i]))) {  // the light adds nothing here
@@ -152,15 +230,17 @@ void LectureShading::direct_lighting_with(const SurfaceHit* hits, const Ray* ray
                     if (lit[i]) terms.shadow_ray = shadow_rays[i];
                     terms.shadow_tested = query[i];
                     terms.blocked = query[i] && blocked[i];
+                    if (m_transmits) terms.filter = filter[i];
                     observer.light(i, level, light_index, terms);
                 }
             }
             if (!lit[i] || (query[i] && blocked[i])) continue;  // a blocked light adds neither term
             const Material& material = m_scene.materials[hits[i].material];
             const Vec3& to_light = shadow_rays[i].direction;
-            const Color diffuse = material.kd * light.intensity * n_dot_l[i];
+            const Color intensity = m_transmits ? light.intensity * filter[i] : light.intensity;
+            const Color diffuse = material.kd * intensity * n_dot_l[i];
             const Color specular =
-                material.ks * light.intensity * specular_lobe(material, normal[i], -rays[i].direction, to_light);
+                material.ks * intensity * specular_lobe(material, normal[i], -rays[i].direction, to_light);
             local[i] += diffuse + specular;
             if constexpr (Observer::watching) {
                 LightTerms terms;
@@ -169,6 +249,7 @@ void LectureShading::direct_lighting_with(const SurfaceHit* hits, const Ray* ray
                 terms.facing = true;
                 terms.shadow_ray = shadow_rays[i];
                 terms.shadow_tested = query[i];
+                if (m_transmits) terms.filter = filter[i];
                 terms.diffuse = diffuse;
                 terms.specular = specular;
                 observer.light(i, level, light_index, terms);
@@ -180,25 +261,30 @@ void LectureShading::direct_lighting_with(const SurfaceHit* hits, const Ray* ray
 void LectureShading::trace_packet(const Ray* first_rays, int count, int hits_so_far, Color* radiance,
                                   RayCounts& counts) const {
     NoObserver none;
-    trace_packet_with(first_rays, count, hits_so_far, radiance, counts, none);
+    for (int i = 0; i < count; ++i) radiance[i] = Color(0.0);
+    trace_paths(first_rays, nullptr, nullptr, count, hits_so_far, radiance, counts, none);
 }
 
 void LectureShading::trace_packet(const Ray* first_rays, int count, int hits_so_far, Color* radiance, RayCounts& counts,
                                   PathObserver& observer) const {
     Watching watching{observer};
-    trace_packet_with(first_rays, count, hits_so_far, radiance, counts, watching);
+    for (int i = 0; i < count; ++i) radiance[i] = Color(0.0);
+    trace_paths(first_rays, nullptr, nullptr, count, hits_so_far, radiance, counts, watching);
 }
 
 template <class Observer>
-void LectureShading::trace_packet_with(const Ray* first_rays, int count, int hits_so_far, Color* radiance,
-                                       RayCounts& counts, Observer& observer) const {
+void LectureShading::trace_paths(const Ray* first_rays, const Color* first_weights, const Interiors* first_interiors,
+                                 int count, int hits_so_far, Color* radiance, RayCounts& counts,
+                                 Observer& observer) const {
     PacketArray<Ray, packet_size> rays;
     PacketArray<Color, packet_size> weight;  // product of the mirror coefficients along the path so far
     bool active[packet_size] = {};
+    // The transmitting objects each path is inside (only ever filled where a material has kt).
+    std::array<Interiors, packet_size> interiors;
     for (int i = 0; i < count; ++i) {
         rays[i] = first_rays[i];
-        weight[i] = Color(1.0);
-        radiance[i] = Color(0.0);
+        weight[i] = first_weights ? first_weights[i] : Color(1.0);
+        if (first_interiors) interiors[i] = first_interiors[i];
         active[i] = true;
     }
     // A path segment past the last allowed surface hit contributes black, not the background
@@ -239,21 +325,45 @@ void LectureShading::trace_packet_with(const Ray* first_rays, int count, int hit
             }
             radiance[i] += added;
             observer.local(i, level, weight[i], local[i], added);
-            if (is_zero(mirror_weight) || level + 1 >= m_scene.max_depth) {
-                active[i] = false;
-                continue;
+            // kt·L(t): the refracted ray, or at total internal reflection the light back along r
+            // with weight 1 in place of km (as POV-Ray 3.7 adds it, docs/pov-model.md §5).
+            bool refracted = false;
+            Ray refracted_ray;
+            Interiors refracted_interiors;
+            if (m_transmits && !is_zero(material.kt) && level + 1 < m_scene.max_depth) {
+                refracted_interiors = interiors[i];
+                Vec3 direction;
+                if (refract(rays[i], hits[i], normal[i], refracted_interiors, direction)) {
+                    refracted = true;
+                    refracted_ray = {hits[i].point, direction, ray_limits::surface_t_min, ray_limits::max_distance};
+                } else {
+                    mirror_weight = Color(1.0);
+                }
             }
+            const Color refracted_weight = refracted ? weight[i] * material.kt : Color(0.0);
+            bool mirrored = !is_zero(mirror_weight) && level + 1 < m_scene.max_depth;
             const Color next_weight = weight[i] * mirror_weight;
-            if (std::max({next_weight.x, next_weight.y, next_weight.z}) < m_scene.min_weight) {
-                active[i] = false;  // render.min_weight: too faint a path to trace further
-                continue;
+            // render.min_weight: too faint a path is not traced further.
+            if (mirrored && std::max({next_weight.x, next_weight.y, next_weight.z}) < m_scene.min_weight)
+                mirrored = false;
+            if (mirrored) {
+                // Mirror: r = 2(n·v)n − v, from the hit point itself (no offset; t_min does the work).
+                const Vec3 mirror_direction = normalize(normal[i] * (2.0 * dot(normal[i], to_eye)) - to_eye);
+                rays[i] = {hits[i].point, mirror_direction, ray_limits::surface_t_min, ray_limits::max_distance};
+                weight[i] = next_weight;
+                observer.mirror(i, level, rays[i], weight[i]);
+                ++counts.reflected;
+            } else {
+                active[i] = false;
             }
-            // Mirror: r = 2(n·v)n − v, from the hit point itself (no offset; t_min does the work).
-            const Vec3 mirror_direction = normalize(normal[i] * (2.0 * dot(normal[i], to_eye)) - to_eye);
-            rays[i] = {hits[i].point, mirror_direction, ray_limits::surface_t_min, ray_limits::max_distance};
-            weight[i] = next_weight;
-            observer.mirror(i, level, rays[i], weight[i]);
-            ++counts.reflected;
+            if (refracted &&
+                !(std::max({refracted_weight.x, refracted_weight.y, refracted_weight.z}) < m_scene.min_weight)) {
+                observer.transmitted(i, level, refracted_ray, refracted_weight);
+                ++counts.reflected;
+                Observer lane = observer.for_lane(i);
+                trace_paths(&refracted_ray, &refracted_weight, &refracted_interiors, 1, level + 1, &radiance[i], counts,
+                            lane);
+            }
         }
     }
 }

@@ -6,6 +6,8 @@
 #include "whitted/scene/scene.h"
 
 #include <cstdint>
+#include <utility>
+#include <vector>
 
 namespace whitted {
 
@@ -13,7 +15,7 @@ namespace whitted {
 struct RayCounts {
     uint64_t camera = 0;
     uint64_t shadow = 0;
-    uint64_t reflected = 0;
+    uint64_t reflected = 0;  ///< secondary rays: mirror rays and refracted rays
     uint64_t total() const { return camera + shadow + reflected; }
     RayCounts& operator+=(const RayCounts& o) {
         camera += o.camera, shadow += o.shadow, reflected += o.reflected;
@@ -28,8 +30,11 @@ struct LightTerms {
     bool facing = false;         ///< n·l > cosine_epsilon: the light is in front of the surface
     Ray shadow_ray;              ///< from x toward the light; set where `facing`
     bool shadow_tested = false;  ///< the shadow ray's range was not empty (else the light is on the surface)
-    bool blocked = false;        ///< something lies on the shadow ray
-    Color diffuse, specular;     ///< kd·I·(n·l) and ks·I·lobe; zero unless facing and not blocked
+    bool blocked = false;        ///< something opaque lies on the shadow ray
+    /// The product of the kt of the transmitting surfaces the shadow ray crosses (1: none);
+    /// the light reaches the point as I·filter.
+    Color filter{1.0};
+    Color diffuse, specular;  ///< kd·I·filter·(n·l) and ks·I·filter·lobe; zero unless facing and not blocked
 };
 
 /// Watches LectureShading evaluate the equation, lane by lane and path segment by segment
@@ -49,25 +54,37 @@ public:
     virtual void light(int lane, int level, size_t light, const LightTerms& terms) = 0;
     /// local = ka·Ia + Σ(diffuse + specular) at the hit; `added` = weight·local went into the radiance.
     virtual void local(int lane, int level, const Color& weight, const Color& local, const Color& added) = 0;
-    /// The mirror ray r leaves the hit; `weight` is the path's new weight (times km).
+    /// The mirror ray r leaves the hit; `weight` is the path's new weight (times km, or times 1
+    /// where the refracted ray is totally reflected).
     virtual void mirror(int lane, int level, const Ray& mirror_ray, const Color& weight) = 0;
+    /// The refracted ray t leaves the hit, after `mirror` (if any); `weight` is its path's weight
+    /// (times kt). Its path is traced before the mirror ray's: its segments come first.
+    virtual void transmitted(int lane, int level, const Ray& refracted_ray, const Color& weight) = 0;
 };
+
+/// The transmitting objects a ray is inside, innermost last: (object number, index of refraction).
+using Interiors = std::vector<std::pair<uint32_t, double>>;
 
 /// The lecture's shading model, evaluated Whitted-style:
 ///
-///   L = ka·Ia + Σ_i [ kd·I_i·max(0, n·l_i) + ks·I_i·max(0, n·h_i)^p ] + km·L(r)
+///   L = ka·Ia + Σ_i [ kd·I_i·max(0, n·l_i) + ks·I_i·max(0, n·h_i)^p ] + km·L(r) + kt·L(t)
 ///
 /// with the conventions of scene-format v1 (and POV-Ray 3.7): two-sided normals, a light
 /// counts only where n·l_i > 1e-10 and its shadow ray is clear, and then adds both its diffuse
-/// and its specular term; r = 2(n·v)n − v is traced while the path has surface hits left.
+/// and its specular term; r = 2(n·v)n − v is traced while the path has surface hits left. The
+/// refracted ray t (Whitted 1980) bends by Snell's law; where it cannot leave (total internal
+/// reflection) the light comes back along r with weight 1 in place of both km·L(r) and
+/// kt·L(t). A shadow ray crossing transmitting surfaces brings I times the product of their kt.
 ///
 /// The recursion km·L(r) is unrolled into a loop over path segments with a running weight
 /// (the product of the km met so far), so that up to a packet of neighbouring rays is traced
 /// together at every level: camera rays, then their shadow rays light by light, then their
-/// mirror rays.
+/// mirror rays. Each refracted ray starts a path of its own, traced at once, depth first.
 class LectureShading {
 public:
-    LectureShading(const Scene& scene, const Accelerator& accelerator) : m_scene(scene), m_accelerator(accelerator) {}
+    LectureShading(const Scene& scene, const Accelerator& accelerator) : m_scene(scene), m_accelerator(accelerator) {
+        for (const Material& material : scene.materials) m_transmits |= !is_zero(material.kt);
+    }
 
     /// Radiance along `ray`, which is the `hits_so_far`-th segment of its path (0 = camera ray).
     Color trace(const Ray& ray, int hits_so_far, RayCounts& counts) const;
@@ -100,15 +117,26 @@ public:
 private:
     /// trace_packet and direct_lighting, with `Observer` either PathObserver or NoObserver, whose
     /// calls compile to nothing: a render without layers pays nothing for them.
+    /// The paths of `count` rays, each starting with weight first_weights[i] (1 if null) inside
+    /// first_interiors[i] (none if null); their radiance is added to radiance[i], term by term
+    /// in the order the observer is told them.
     template <class Observer>
-    void trace_packet_with(const Ray* rays, int count, int hits_so_far, Color* radiance, RayCounts& counts,
-                           Observer& observer) const;
+    void trace_paths(const Ray* rays, const Color* first_weights, const Interiors* first_interiors, int count,
+                     int hits_so_far, Color* radiance, RayCounts& counts, Observer& observer) const;
+    /// The refracted ray at a hit of a material with kt, as POV-Ray 3.7 bends it (docs/pov-model.md
+    /// §5): η from the objects the ray is inside, Heckbert's formula; false for total internal
+    /// reflection. `interiors` becomes the refracted ray's.
+    bool refract(const Ray& ray, const SurfaceHit& hit, const Vec3& normal, Interiors& interiors,
+                 Vec3& direction) const;
+    /// The product of the kt of the surfaces along a shadow ray; 0 where an opaque one blocks it.
+    Color shadow_filter(Ray shadow_ray) const;
     template <class Observer>
     void direct_lighting_with(const SurfaceHit* hits, const Ray* rays, const bool* active, int count, Color* local,
                               Vec3* normal, RayCounts& counts, int level, Observer& observer) const;
 
     const Scene& m_scene;
     const Accelerator& m_accelerator;
+    bool m_transmits = false;  ///< some material has kt: shadow rays walk, refracted rays branch
 };
 
 }  // namespace whitted

@@ -322,7 +322,7 @@ LightDescription parse_light(ParseContext& ctx, const Node& node, const std::str
 }
 
 MaterialDescription parse_material(ParseContext& ctx, const Node& node, const std::string& what) {
-    MapReader map(ctx, node, what, {"ka", "kd", "ks", "p", "km", "highlight", "fresnel_ior"});
+    MapReader map(ctx, node, what, {"ka", "kd", "ks", "p", "km", "highlight", "fresnel_ior", "kt", "ior"});
     MaterialDescription material;
     material.where = map.where();
     map.color(material.ka, "ka");
@@ -334,6 +334,8 @@ MaterialDescription parse_material(ParseContext& ctx, const Node& node, const st
         return parse_choice<Highlight>(c, n, w, {{"blinn", Highlight::blinn}, {"phong", Highlight::phong}});
     });
     map.number(material.fresnel_ior, "fresnel_ior");
+    map.color(material.kt, "kt");
+    map.number(material.ior, "ior");
     if (material.fresnel_ior.given && material.km.given)
         ctx.fail(map.get("fresnel_ior"),
                  what + ": give km or fresnel_ior, not both (fresnel_ior sets the mirror weight)");

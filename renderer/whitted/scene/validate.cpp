@@ -50,8 +50,15 @@ Material make_material(const MaterialDescription& d, const std::string& what) {
     require_non_negative(d.ks, what + ".ks");
     require_non_negative(d.km, what + ".km");
     if (!(d.p.value > 0)) fail(d.p.where, what + ".p: the specular exponent must be > 0");
+    require_non_negative(d.kt, what + ".kt");
+    if (!(d.ior.value > 0 && std::isfinite(d.ior.value)))
+        fail(d.ior.where, what + ".ior: the index of refraction must be a finite number > 0");
+    if (d.fresnel_ior.given && !is_zero(d.kt.value))
+        fail(d.kt.where, what + ": kt (refraction) and fresnel_ior (the course's glaze) cannot be combined");
     Material material{d.ka.value, d.kd.value, d.ks.value, d.p.value, d.km.value, d.highlight.value};
     if (d.fresnel_ior.given) material.fresnel_r0 = fresnel_r0(d.fresnel_ior, what);
+    material.kt = d.kt.value;
+    material.ior = d.ior.value;
     return material;
 }
 
