@@ -413,6 +413,19 @@ void refuse_unwritable(const std::filesystem::path& target) {
                                     "' does not exist");
     if (std::filesystem::is_directory(target, error))
         throw std::invalid_argument("cannot write '" + target.string() + "': it is a directory");
+    try {
+        refuse_special_target(target);  // never a device, FIFO or socket
+    } catch (const std::runtime_error& e) {
+        throw std::invalid_argument(e.what());
+    }
+}
+
+/// A usage error when writing `target` would replace `input`, a file the same command reads.
+void refuse_overwriting_input(const std::filesystem::path& target, const std::string& input) {
+    std::error_code error;
+    if (std::filesystem::exists(target, error) && std::filesystem::equivalent(target, input, error) && !error)
+        throw std::invalid_argument("cannot write '" + target.string() + "': it is the input '" + input +
+                                    "' of the same command");
 }
 
 int run_convert(const std::string& scene_path, const std::string& output) {
@@ -429,7 +442,8 @@ int run_convert(const std::string& scene_path, const std::string& output) {
         std::filesystem::path ini_path(output);
         ini_path.replace_extension(".ini");
         refuse_unwritable(output);
-        if (!to_yaml) refuse_unwritable(ini_path);
+        refuse_overwriting_input(output, scene_path);
+        if (!to_yaml) refuse_unwritable(ini_path), refuse_overwriting_input(ini_path, scene_path);
         const SceneDescription description = parse_scene_file(scene_path);
         validate_scene(description);  // refuse what Whitted itself would refuse
         if (to_yaml) {
@@ -487,6 +501,7 @@ int run_colour(bool list, const std::string& config, const std::string& write_co
     try {
         if (!config.empty() && !list) throw std::invalid_argument("--ocio-config goes with --list");
         if (!write_config.empty()) {
+            refuse_unwritable(write_config);  // before a byte is written; /dev/full stays a device
             const std::string text = DisplayTransform::builtin_config_text();
             write_files_atomically({{write_config, text}});
             std::fprintf(stderr, "whitted: wrote the built-in OpenColorIO config to %s\n", write_config.c_str());

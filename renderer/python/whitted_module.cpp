@@ -48,6 +48,16 @@ T take(api::Expected<T>&& expected) {
     if (!expected) raise(expected.error());
     return std::move(expected).value();
 }
+void take(api::Expected<void>&& expected) {
+    if (!expected) raise(expected.error());
+}
+
+/// `threads` as the program takes it (-t): 0 (all cores) to 4096.
+int checked_threads(int threads) {
+    if (threads < 0 || threads > 4096)
+        throw py::value_error("threads: " + std::to_string(threads) + " not in [0 - 4096] (0: all cores)");
+    return threads;
+}
 
 /// An image's floats as a NumPy array (H×W×C) that owns the Image: no copy.
 py::array_t<float> array_of(std::shared_ptr<whitted::Image> image, float* data, size_t channels) {
@@ -163,7 +173,8 @@ PYBIND11_MODULE(whitted, m) {
     m.attr("__version__") = api::version();
     m.def("version", &api::version, "The library's version (the same as whitted.__version__).");
 
-    static py::exception<std::runtime_error> error_type(m, "Error");
+    static py::exception<std::runtime_error> error_type(m, "Error",
+                                                        PyExc_RuntimeError);  // docs/library.md: a RuntimeError
     g_error_type = error_type.ptr();
     py::setattr(error_type, "__doc__",
                 py::str("A bad scene, option or file: str() is 'FILE:LINE:COL: message'; the attributes "
@@ -190,7 +201,7 @@ PYBIND11_MODULE(whitted, m) {
     m.def(
         "render",
         [](const api::Scene& scene, int threads, const py::object& progress) {
-            auto result = render_releasing_gil(scene, threads, {"none"}, progress);
+            auto result = render_releasing_gil(scene, checked_threads(threads), {"none"}, progress);
             auto image = std::make_shared<whitted::Image>(std::move(result.image));
             float* data = image->rgb.data();
             return array_of(std::move(image), data, 3);
@@ -203,7 +214,7 @@ PYBIND11_MODULE(whitted, m) {
     m.def(
         "render_layers",
         [](const api::Scene& scene, const std::vector<std::string>& layers, int threads, const py::object& progress) {
-            auto result = render_releasing_gil(scene, threads, layers, progress);
+            auto result = render_releasing_gil(scene, checked_threads(threads), layers, progress);
             auto image = std::make_shared<whitted::Image>(std::move(result.image));
             py::dict out;
             out["beauty"] = array_of(image, image->rgb.data(), 3);
@@ -222,6 +233,9 @@ PYBIND11_MODULE(whitted, m) {
            const std::string& exr_compression, int bit_depth, const std::string& ocio_config,
            const std::string& display, const std::string& view) {
             if (rgb.ndim() != 3 || rgb.shape(2) != 3) throw py::value_error("write_image: the array must be H x W x 3");
+            if (rgb.shape(0) < 1 || rgb.shape(1) < 1 || rgb.shape(0) > 65536 || rgb.shape(1) > 65536)
+                throw py::value_error("write_image: the image must be 1 to 65536 pixels on each side, got " +
+                                      std::to_string(rgb.shape(1)) + " x " + std::to_string(rgb.shape(0)));
             whitted::Image image;
             image.height = int(rgb.shape(0));
             image.width = int(rgb.shape(1));
@@ -233,8 +247,12 @@ PYBIND11_MODULE(whitted, m) {
             options.ocio_config = ocio_config;
             options.display = display;
             options.view = view;
-            py::gil_scoped_release release;
-            take(api::write_image(image, path, options));
+            // The error is raised with the GIL held again: raising while it is released crashed.
+            api::Expected<void> written = [&] {
+                py::gil_scoped_release release;
+                return api::write_image(image, path, options);
+            }();
+            take(std::move(written));
         },
         py::arg("image"), py::arg("path"), py::arg("half") = false, py::arg("exr_compression") = "",
         py::arg("bit_depth") = 0, py::arg("ocio_config") = "", py::arg("display") = "", py::arg("view") = "",
@@ -263,7 +281,7 @@ PYBIND11_MODULE(whitted, m) {
         [](const std::string& path, int threads, double tolerance, double min_fraction, double max_error,
            const std::string& report_dir, bool quiet) {
             api::CheckOptions options;
-            options.threads = threads;
+            options.threads = checked_threads(threads);
             options.tolerance_codes = tolerance;
             options.min_fraction = min_fraction;
             options.max_error_codes = max_error;

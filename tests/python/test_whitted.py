@@ -195,3 +195,52 @@ def test_check_against_povray():
     assert 0.999 <= result.fraction_within <= 1
     with pytest.raises(whitted.Error):
         whitted.check("/nonexistent/scene.yaml")
+
+
+# Every failure of the module's functions is an exception, never a signal: each case runs in a
+# child interpreter (a crash there is a negative exit status, not a lost test run), which prints
+# the exception's type and ends with exit 0.
+ERROR_PATHS = {
+    "write_image to an unknown format": (
+        "whitted.write_image(np.zeros((2, 2, 3), np.float32), OUT + '/x.bmp')", "Error"),
+    "write_image into a missing folder": (
+        "whitted.write_image(np.zeros((2, 2, 3), np.float32), OUT + '/no/such/dir/x.png')", "Error"),
+    "write_image with an unknown display": (
+        "whitted.write_image(np.zeros((2, 2, 3), np.float32), OUT + '/x.png', display='Nope')", "Error"),
+    "write_image of an empty array (0, 5, 3)": ("whitted.write_image(np.zeros((0, 5, 3), np.float32), OUT + '/e.png')",
+                                                "ValueError"),
+    "write_image of an empty array (5, 0, 3)": ("whitted.write_image(np.zeros((5, 0, 3), np.float32), OUT + '/e.exr')",
+                                                "ValueError"),
+    "write_image of an empty array (0, 0, 3)": ("whitted.write_image(np.zeros((0, 0, 3), np.float32), OUT + '/e.exr')",
+                                                "ValueError"),
+    "render with threads=-1": ("whitted.render(SCENE, threads=-1)", "ValueError"),
+    "render with threads=10**9": ("whitted.render(SCENE, threads=10**9)", "ValueError"),
+    "render with threads=2**31-1": ("whitted.render(SCENE, threads=2**31 - 1)", "ValueError"),
+    "render_layers with threads=10**7": ("whitted.render_layers(SCENE, ['diffuse'], threads=10**7)", "ValueError"),
+    "check with threads=-5": ("whitted.check(SHADOWS, threads=-5)", "ValueError"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(ERROR_PATHS))
+def test_every_error_path_raises(case, tmp_path):
+    call, expected = ERROR_PATHS[case]
+    program = textwrap.dedent(f"""
+        import numpy as np, whitted
+        OUT = {str(tmp_path)!r}
+        SHADOWS = {SHADOWS!r}
+        SCENE = whitted.load(SHADOWS)
+        try:
+            {call}
+        except Exception as e:
+            print(type(e).__name__, isinstance(e, RuntimeError) if type(e).__name__ == 'Error' else '', e)
+        else:
+            print('NOTHING RAISED')
+    """)
+    result = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, f"{case}: exit {result.returncode}\n{result.stderr[-2000:]}"
+    kind = result.stdout.split()[0] if result.stdout.split() else ""
+    assert kind == expected, f"{case}: {result.stdout}{result.stderr[-2000:]}"
+    if expected == "Error":
+        assert result.stdout.split()[1] == "True", "whitted.Error is a RuntimeError"
+    # Nothing half-written is left behind.
+    assert not [p for p in os.listdir(tmp_path) if "tmp" in p], os.listdir(tmp_path)

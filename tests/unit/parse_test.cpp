@@ -288,5 +288,29 @@ TEST(ParseErrors, AliasBombIsRefusedQuickly) {
     RecordProperty("seconds", std::to_string(seconds));
 }
 
+TEST(ParseErrors, ManyAndHugeNamesGetABoundedMessage) {
+    // 100,000 materials (defined-twice checks by one look each, not a walk of the list), and an
+    // unknown name of 100,000 bytes with control characters: the message lists 20 names,
+    // printable, suggests nothing, and says how many there are.
+    std::string text = "camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\nimage: {width: 2, height: 2}\nmaterials:\n";
+    for (int i = 0; i < 100000; ++i) text += "  m" + std::to_string(i) + ": {kd: 1}\n";
+    const std::string huge = "\\e[2J" + std::string(100000, 'x');
+    text += "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, material: \"" + huge + "\"}\n";
+    const auto error = test::input_error_from([&] { (void)load_scene_text(text, "many.yaml"); });
+    ASSERT_TRUE(error);
+    const std::string message = error->message();
+    EXPECT_LT(message.size(), 2000u) << message.substr(0, 300);
+    EXPECT_THAT(message, ::testing::HasSubstr("(100000 in all)"));
+    EXPECT_THAT(message, ::testing::Not(::testing::HasSubstr("did you mean")));
+    EXPECT_EQ(message.find('\x1b'), std::string::npos);
+    // A name defined twice among them is still found, at its place.
+    const std::string twice =
+        "camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\nimage: {width: 2, height: 2}\n"
+        "materials:\n  a: {kd: 1}\n  b: {kd: 1}\n  a: {kd: 0.5}\n";
+    const auto duplicate = test::input_error_from([&] { (void)parse_scene_text(twice, "twice.yaml"); });
+    ASSERT_TRUE(duplicate);
+    EXPECT_EQ(duplicate->where().line, 6);
+}
+
 }  // namespace
 }  // namespace whitted

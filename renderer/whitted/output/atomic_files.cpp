@@ -106,6 +106,8 @@ Moved move_keeping_previous(const std::string& temporary, const std::filesystem:
     Moved moved{target, temporary};
     struct stat existing {};
     const bool exists = ::lstat(target.c_str(), &existing) == 0;
+    // The new file keeps the mode of the one it replaces (a private 0600 output stays private).
+    if (exists && S_ISREG(existing.st_mode)) ::chmod(temporary.c_str(), existing.st_mode & 07777);
     if (exists && S_ISREG(existing.st_mode) &&
         ::renameat2(AT_FDCWD, temporary.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) == 0) {
         moved.exchanged = true;
@@ -169,7 +171,16 @@ std::string temporary_path(const std::filesystem::path& target) {
     return (directory / temporary_name(target, ::getpid())).string();
 }
 
+void refuse_special_target(const std::filesystem::path& target) {
+    struct stat existing {};
+    if (::stat(target.c_str(), &existing) == 0 && !S_ISREG(existing.st_mode) && !S_ISDIR(existing.st_mode))
+        throw std::runtime_error("cannot write '" + target.string() +
+                                 "': it is not a regular file (a device, FIFO or socket); Whitted writes only "
+                                 "regular files and never replaces anything else");
+}
+
 void move_into_place(const std::string& temporary, const std::filesystem::path& target) {
+    refuse_special_target(target);
     remove_abandoned_temporaries(target);
     // An existing file is swapped out atomically (RENAME_EXCHANGE) and then deleted under the
     // temporary name: a rename over it made ext4 start writing the new file to disk before
@@ -177,8 +188,9 @@ void move_into_place(const std::string& temporary, const std::filesystem::path& 
     // against under 1 ms this way. Anything but a regular file there (nothing, a link, a
     // directory), or a filesystem that cannot exchange: a plain rename, with its refusals.
     struct stat existing {};
-    if (::lstat(target.c_str(), &existing) == 0 && S_ISREG(existing.st_mode) &&
-        ::renameat2(AT_FDCWD, temporary.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) == 0) {
+    const bool regular = ::lstat(target.c_str(), &existing) == 0 && S_ISREG(existing.st_mode);
+    if (regular) ::chmod(temporary.c_str(), existing.st_mode & 07777);  // keeps a 0600 output private
+    if (regular && ::renameat2(AT_FDCWD, temporary.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) == 0) {
         std::remove(temporary.c_str());  // the old file
         return;
     }
@@ -187,6 +199,7 @@ void move_into_place(const std::string& temporary, const std::filesystem::path& 
 }
 
 void write_files_atomically(const std::vector<std::pair<std::filesystem::path, std::string_view>>& files) {
+    for (const auto& [target, bytes] : files) refuse_special_target(target);  // before a byte is written
     std::vector<Pending> pending(files.size());
     try {
         for (size_t i = 0; i < files.size(); ++i) {

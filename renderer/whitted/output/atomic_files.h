@@ -28,6 +28,9 @@ std::string temporary_path(const std::filesystem::path& target);
 
 /// Moves a finished file to `target` in one step: an existing regular file is swapped out
 /// atomically and then deleted, anything else renamed over. Throws std::runtime_error.
+/// Throws std::runtime_error when `target` exists and is neither a regular file nor a directory
+/// (a device such as /dev/full, a FIFO, a socket, or a link to one): an output never replaces it.
+void refuse_special_target(const std::filesystem::path& target);
 void move_into_place(const std::string& temporary, const std::filesystem::path& target);
 
 void write_files_atomically(const std::vector<std::pair<std::filesystem::path, std::string_view>>& files);

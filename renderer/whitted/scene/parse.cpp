@@ -17,6 +17,7 @@
 #include <cmath>
 #include <exception>
 #include <filesystem>
+#include <unordered_set>
 
 namespace whitted {
 namespace {
@@ -152,13 +153,23 @@ size_t edit_distance(const std::string& a, const std::string& b) {
 }  // namespace
 
 std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates) {
+    // Bounded work whatever the input: names longer than a word anyone types get no suggestion,
+    // a candidate whose length alone puts it out of reach is not compared, and at most a few
+    // thousand are (a hostile file may define a million names, each a megabyte long).
+    constexpr size_t longest = 64, most_compared = 4096;
+    if (word.size() > longest) return {};
     std::string best;
-    size_t best_distance = std::max<size_t>(2, word.size() / 3) + 1;
+    size_t best_distance = std::max<size_t>(2, word.size() / 3) + 1, compared = 0;
     for (const auto& candidate : candidates) {
+        if (candidate.size() > longest) continue;
+        const size_t apart =
+            candidate.size() > word.size() ? candidate.size() - word.size() : word.size() - candidate.size();
+        if (apart >= best_distance) continue;
+        if (++compared > most_compared) break;
         const size_t d = edit_distance(word, candidate);
         if (d < best_distance) best_distance = d, best = candidate;
     }
-    return best.empty() ? std::string() : " (did you mean '" + best + "'?)";
+    return best.empty() ? std::string() : " (did you mean '" + printable(best) + "'?)";
 }
 
 namespace {
@@ -635,6 +646,8 @@ SceneDescription parse_document(ParseContext& ctx, const Node& root) {
                 scene.lights.push_back(parse_light(ctx, lights[i], "lights[" + std::to_string(i) + "]"));
         }
     }
+    // Names defined so far, to find one defined twice in one look each (not a walk of the list).
+    std::unordered_set<std::string> material_names, prototype_names;
     if (map.has("materials")) {
         const Node materials = map.get("materials");
         if (!materials.IsNull()) {
@@ -644,7 +657,7 @@ SceneDescription parse_document(ParseContext& ctx, const Node& root) {
                 if (!entry.first.IsScalar() || entry.first.Scalar().empty())
                     ctx.fail(entry.first, "materials: names must be plain, non-empty words");
                 const std::string name = entry.first.Scalar();
-                if (scene.find_material(name))
+                if (!material_names.insert(name).second)
                     ctx.fail(entry.first, "materials: '" + printable(name) + "' is defined twice");
                 MaterialDescription material = parse_material(ctx, entry.second, "materials." + name);
                 material.name = name;
@@ -663,7 +676,7 @@ SceneDescription parse_document(ParseContext& ctx, const Node& root) {
                 PrototypeDescription prototype;
                 prototype.name = entry.first.Scalar();
                 prototype.where = ctx.at(entry.first);
-                if (scene.find_prototype(prototype.name))
+                if (!prototype_names.insert(prototype.name).second)
                     ctx.fail(entry.first, "prototypes: '" + printable(prototype.name) + "' is defined twice");
                 prototype.object = parse_object(ctx, entry.second, "prototypes." + prototype.name, 0);
                 scene.prototypes.push_back(std::move(prototype));

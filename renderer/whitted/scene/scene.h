@@ -27,8 +27,8 @@ struct Material {
     /// Schlick's R0 = ((η−1)/(η+1))² when the material has `fresnel_ior`, else negative: km is
     /// then the mirror weight, unscaled.
     double fresnel_r0 = -1;
-    Color kt;        ///< transmission: the weight of the refracted ray (Whitted 1980)
-    double ior = 1;  ///< index of refraction inside the surface
+    Color kt = Color(0.0);  ///< transmission: the weight of the refracted ray (Whitted 1980)
+    double ior = 1;         ///< index of refraction inside the surface
 };
 
 struct Camera {

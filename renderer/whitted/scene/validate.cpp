@@ -198,8 +198,7 @@ private:
     };
 
     [[noreturn]] static void fail_unknown_material(const NameUse& use, const std::vector<std::string>& names) {
-        std::string known;
-        for (const auto& name : names) known += (known.empty() ? "" : ", ") + name;
+        const std::string known = join_names(names);
         fail(use.where, use.kind + ": unknown material '" + printable(use.name) + "'" + did_you_mean(use.name, names) +
                             (known.empty() ? "; the scene defines no materials" : "; defined: " + known));
     }
@@ -376,9 +375,13 @@ private:
         m_scene.instances.push_back(instance);
     }
 
+    /// The first 20 names as printable() shows them, and how many there are in all beyond that.
     static std::string join_names(const std::vector<std::string>& names) {
+        constexpr size_t most_listed = 20;
         std::string out;
-        for (const auto& name : names) out += (out.empty() ? "" : ", ") + printable(name);
+        for (size_t i = 0; i < names.size() && i < most_listed; ++i)
+            out += (out.empty() ? "" : ", ") + printable(names[i], 40);
+        if (names.size() > most_listed) out += ", ... (" + std::to_string(names.size()) + " in all)";
         return out;
     }
 
