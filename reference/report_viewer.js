@@ -227,7 +227,7 @@
             out.appendChild(t);
             const note = document.createElement("p");
             note.className = "help";
-            note.textContent = "ambient + diffuse + specular + mirror + background is Whitted's value (summed in float, " +
+            note.textContent = "ambient + diffuse + specular + mirror + transmission + background is Whitted's value (summed in float, " +
                                "in that order); light<k> is light k's share of diffuse + specular.";
             out.appendChild(note);
         }

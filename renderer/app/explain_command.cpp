@@ -191,9 +191,9 @@ void print_text(const Scene& scene, const std::string& path, const PixelExplanat
     std::printf("as float (the R, G, B of `whitted render`'s EXR): %s\n",
                 fmt::format("({}, {}, {})", e.rgb[0], e.rgb[1], e.rgb[2]).c_str());
     const PathLayers& c = e.layers.sum;
-    std::printf("render layers: ambient %s + diffuse %s + specular %s + mirror %s + background %s\n",
+    std::printf("render layers: ambient %s + diffuse %s + specular %s + mirror %s + transmission %s + background %s\n",
                 vec(c.ambient).c_str(), vec(c.diffuse).c_str(), vec(c.specular).c_str(), vec(c.mirror).c_str(),
-                vec(c.background).c_str());
+                vec(c.transmission).c_str(), vec(c.background).c_str());
     std::printf("  = %s as the float sum (the R, G, B of an EXR rendered with --layers)\n",
                 fmt::format("({}, {}, {})", e.layer_beauty[0], e.layer_beauty[1], e.layer_beauty[2]).c_str());
 }
@@ -290,6 +290,7 @@ nlohmann::json to_json(const Scene& scene, const std::string& path, const PixelE
               {"diffuse", jvec(c.diffuse)},
               {"specular", jvec(c.specular)},
               {"mirror", jvec(c.mirror)},
+              {"transmission", jvec(c.transmission)},
               {"background", jvec(c.background)},
               {"lights", lights},
               {"beauty", {double(e.layer_beauty[0]), double(e.layer_beauty[1]), double(e.layer_beauty[2])}}}}};

@@ -616,7 +616,7 @@ int main(int argc, char** argv) {
             "--layers", render_args.layers,
             "EXR only: write render layers as extra channels, 'all' or a comma-separated list of: " + layer_choices() +
                 " (docs/layers.md); overrides the scene's render.layers, 'none' turns them off. The "
-                "beauty R, G, B is then the float sum of ambient, diffuse, specular, mirror, background")
+                "beauty R, G, B is then the float sum of ambient, diffuse, specular, mirror, transmission, background")
         ->delimiter(',');
 
     std::string explain_scene, explain_pixel_text;

@@ -87,7 +87,7 @@ def expectations_for_report(report, layers_wanted):
     beauty_exposed = (beauty.astype(np.float64) * exposure).astype(np.float32)
     layer_names = sorted({n.split(".")[0] for n in names if "." in n})
     colour_layers = [n for n in layer_names if all(f"{n}.{c}" in channel for c in "RGB") and
-                     (n in ("ambient", "diffuse", "specular", "mirror", "background") or re.fullmatch(r"light\d+", n))]
+                     (n in ("ambient", "diffuse", "specular", "mirror", "transmission", "background") or re.fullmatch(r"light\d+", n))]
     if layers_wanted and not {"ambient", "diffuse", "specular"} <= set(colour_layers):
         fail(f"ours.exr has layers {layer_names}, expected the colour layers of --layers all")
     if not layers_wanted and layer_names:

@@ -33,7 +33,7 @@ import sys
 import numpy as np
 import OpenImageIO as oiio
 
-COLOUR_TERMS = ["ambient", "diffuse", "specular", "mirror", "background"]
+COLOUR_TERMS = ["ambient", "diffuse", "specular", "mirror", "transmission", "background"]
 
 
 def run(args, expect=0):
@@ -169,6 +169,7 @@ def case_closed(whitted, out_dir):
         "diffuse": [kd[c] * i1[c] * dot(n, l) for c in range(3)],
         "specular": [ks[c] * i1[c] * dot(n, h) ** p for c in range(3)],
         "mirror": [km[c] * bg[c] for c in range(3)],
+        "transmission": [0, 0, 0],
         "background": [0, 0, 0],
         "light2": [0, 0, 0],
         "albedo": kd,

@@ -104,7 +104,7 @@ TEST_P(LayersPerSamples, WatchingChangesNothingAndTheLayersAddUp) {
                 for (int k = 0; k < count; ++k) {
                     ASSERT_EQ(std::memcmp(&plain[k], &watched[k], sizeof(Color)), 0) << i << "," << j;
                     const PathLayers& l = recorder.lane(k);
-                    const Color sum = l.ambient + l.diffuse + l.specular + l.mirror + l.background;
+                    const Color sum = l.ambient + l.diffuse + l.specular + l.mirror + l.transmission + l.background;
                     for (int c = 0; c < 3; ++c)
                         EXPECT_NEAR(sum[c], plain[k][c], 1e-12 * std::max(1.0, plain[k][c])) << i << "," << j;
                     Color lights(0.0);
@@ -127,7 +127,7 @@ TEST_P(LayersPerSamples, BeautyIsTheFloatSumOfTheLayersForAnyThreadCount) {
     options.threads = 1;
     options.layers = LayerSet::all();
     const RenderResult one = render(scene, accelerator, options);
-    ASSERT_EQ(one.image.layers.size(), 5u + 2u + 8u);  // ambient..background, light1..2, N..hits
+    ASSERT_EQ(one.image.layers.size(), 6u + 2u + 8u);  // ambient..background, light1..2, N..hits
     options.threads = 3;
     const RenderResult three = render(scene, accelerator, options);
     options.layers = LayerSet();
@@ -143,7 +143,7 @@ TEST_P(LayersPerSamples, BeautyIsTheFloatSumOfTheLayersForAnyThreadCount) {
     for (size_t p = 0; p < pixels; ++p)
         for (int c = 0; c < 3; ++c) {
             float sum = 0.0f;
-            for (int l = 0; l < 5; ++l) sum += one.image.layers[l].values[3 * p + c];
+            for (int l = 0; l < 6; ++l) sum += one.image.layers[l].values[3 * p + c];
             ASSERT_EQ(sum, one.image.rgb[3 * p + c]) << "pixel " << p;
             const float without = plain.image.rgb[3 * p + c];
             EXPECT_LE(std::fabs(sum - without), 4e-7f * std::max(1.0f, without));
@@ -173,6 +173,36 @@ TEST_P(LayersPerSamples, ExplainGivesEveryPixelOfTheRender) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Samples, LayersPerSamples, testing::Values(1, 3));
+
+// A glass ball: what its refracted rays bring back is the transmission layer, what its mirror
+// rays bring back the mirror layer, and the colour layers still add up to the beauty.
+TEST(Layers, RefractedRaysFillTheTransmissionLayer) {
+    const Scene scene = test::scene_from(
+        "camera: {eye: [0, 1, 5], look_at: [0, 0.5, 0], fov: 40}\n"
+        "image: {width: 24, height: 18}\n"
+        "lights: [{type: point, position: [2, 5, 4]}]\n"
+        "objects:\n"
+        "  - {type: plane, point: [0, 0, 0], normal: [0, 1, 0], material: {ka: 0.1, kd: 0.8}}\n"
+        "  - {type: sphere, center: [0, 0.6, 0], radius: 0.6, material: {ks: 0.3, p: 20, km: 0.1, kt: 0.8, ior: "
+        "1.5}}\n");
+    const Accelerator accelerator(scene, 2);
+    RenderOptions options;
+    options.layers = LayerSet::all();
+    const RenderResult result = render(scene, accelerator, options);
+    ASSERT_EQ(result.image.layers[4].name, "transmission");
+    const size_t pixels = size_t(scene.width) * scene.height;
+    double transmitted = 0, mirrored = 0;
+    for (size_t p = 0; p < pixels; ++p)
+        for (int c = 0; c < 3; ++c) {
+            float sum = 0.0f;
+            for (int l = 0; l < 6; ++l) sum += result.image.layers[size_t(l)].values[3 * p + c];
+            ASSERT_EQ(sum, result.image.rgb[3 * p + c]) << "pixel " << p;
+            transmitted += result.image.layers[4].values[3 * p + c];
+            mirrored += result.image.layers[3].values[3 * p + c];
+        }
+    EXPECT_GT(transmitted, 2 * mirrored);  // kt 0.8 against km 0.1
+    EXPECT_GT(mirrored, 0);
+}
 
 }  // namespace
 }  // namespace whitted

@@ -7,8 +7,9 @@
 namespace whitted {
 
 namespace {
-const char* const names[layer_kinds] = {"ambient", "diffuse", "specular", "mirror", "background", "lights",     "N",
-                                        "Ng",      "P",       "Z",        "albedo", "objectId",   "materialId", "hits"};
+const char* const names[layer_kinds] = {"ambient",    "diffuse", "specular", "mirror",     "transmission",
+                                        "background", "lights",  "N",        "Ng",         "P",
+                                        "Z",          "albedo",  "objectId", "materialId", "hits"};
 constexpr double inf = std::numeric_limits<double>::infinity();
 }  // namespace
 
@@ -53,14 +54,17 @@ LayerSet parse_layers(const std::vector<std::string>& entries) {
     return set;
 }
 
-LayerRecorder::LayerRecorder(const Scene& scene, int lanes) : m_scene(scene), m_lanes(size_t(lanes)) {
+LayerRecorder::LayerRecorder(const Scene& scene, int lanes)
+    : m_scene(scene), m_lanes(size_t(lanes)), m_announced(size_t(lanes)), m_in_transmission(size_t(lanes), false) {
     for (PathLayers& lane : m_lanes) lane.lights.resize(scene.lights.size());
     reset();
 }
 
 void LayerRecorder::reset() {
+    for (auto& announced : m_announced) announced.clear();
+    m_in_transmission.assign(m_in_transmission.size(), false);
     for (PathLayers& lane : m_lanes) {
-        lane.ambient = lane.diffuse = lane.specular = lane.mirror = lane.background = Color(0.0);
+        lane.ambient = lane.diffuse = lane.specular = lane.mirror = lane.transmission = lane.background = Color(0.0);
         for (Color& light : lane.lights) light = Color(0.0);
         lane.N = lane.Ng = lane.P = Vec3(0.0);
         lane.Z = inf;
@@ -70,11 +74,27 @@ void LayerRecorder::reset() {
     }
 }
 
+void LayerRecorder::start_segment(int i, int level) {
+    if (level != 1 || m_announced[size_t(i)].empty()) return;
+    m_in_transmission[size_t(i)] = m_announced[size_t(i)].back();
+    m_announced[size_t(i)].pop_back();
+}
+
+void LayerRecorder::mirror(int i, int level, const Ray&, const Color&) {
+    if (level == 0) m_announced[size_t(i)].push_back(false);
+}
+
+void LayerRecorder::transmitted(int i, int level, const Ray&, const Color&) {
+    if (level == 0) m_announced[size_t(i)].push_back(true);
+}
+
 void LayerRecorder::miss(int i, int level, const Ray&, const Color&, const Color& seen) {
-    (level == 0 ? m_lanes[i].background : m_lanes[i].mirror) += seen;
+    start_segment(i, level);
+    (level == 0 ? m_lanes[i].background : secondary(i)) += seen;
 }
 
 void LayerRecorder::hit(int i, int level, const Ray&, const SurfaceHit& hit, const Vec3& normal) {
+    start_segment(i, level);
     PathLayers& lane = m_lanes[i];
     ++lane.hits;
     if (level != 0) return;
@@ -102,7 +122,7 @@ void LayerRecorder::light(int i, int level, size_t light, const LightTerms& term
 void LayerRecorder::local(int i, int level, const Color&, const Color&, const Color& added) {
     // The first hit's local terms are in ambient, diffuse and specular; every later one, times
     // the mirror weight, is part of what the first mirror ray brings back.
-    if (level != 0) m_lanes[i].mirror += added;
+    if (level != 0) secondary(i) += added;
 }
 
 std::vector<ImageLayer> make_image_layers(const Scene& scene, LayerSet selection) {
@@ -125,6 +145,7 @@ std::vector<ImageLayer> make_image_layers(const Scene& scene, LayerSet selection
             case Layer::diffuse:
             case Layer::specular:
             case Layer::mirror:
+            case Layer::transmission:
             case Layer::background:
                 add(layer_name(layer), {"R", "G", "B"}, false, 0.0f);
                 break;
@@ -154,7 +175,7 @@ std::vector<ImageLayer> make_image_layers(const Scene& scene, LayerSet selection
 }
 
 void PixelLayers::clear() {
-    sum.ambient = sum.diffuse = sum.specular = sum.mirror = sum.background = Color(0.0);
+    sum.ambient = sum.diffuse = sum.specular = sum.mirror = sum.transmission = sum.background = Color(0.0);
     for (Color& light : sum.lights) light = Color(0.0);
 }
 
@@ -164,6 +185,7 @@ void PixelLayers::add_sample(const PathLayers& sample, bool first_sample) {
     sum.diffuse += sample.diffuse;
     sum.specular += sample.specular;
     sum.mirror += sample.mirror;
+    sum.transmission += sample.transmission;
     sum.background += sample.background;
     for (size_t i = 0; i < sample.lights.size(); ++i) sum.lights[i] += sample.lights[i];
     if (first_sample) first = sample;
@@ -176,6 +198,7 @@ void PixelLayers::finish(int samples_per_pixel) {
     sum.diffuse = sum.diffuse / n;
     sum.specular = sum.specular / n;
     sum.mirror = sum.mirror / n;
+    sum.transmission = sum.transmission / n;
     sum.background = sum.background / n;
     for (Color& light : sum.lights) light = light / n;
 }
@@ -192,7 +215,7 @@ void store_pixel_layers(const PixelLayers& pixel, LayerSet selection, std::vecto
     const PathLayers& c = pixel.sum;
     const PathLayers& d = pixel.first;
     // The beauty is the sum of the float layer values, in float, in this fixed order.
-    const Color terms[] = {c.ambient, c.diffuse, c.specular, c.mirror, c.background};
+    const Color terms[] = {c.ambient, c.diffuse, c.specular, c.mirror, c.transmission, c.background};
     for (int channel = 0; channel < 3; ++channel) {
         float total = 0.0f;
         for (const Color& term : terms) total += float(term[channel]);
@@ -214,6 +237,9 @@ void store_pixel_layers(const PixelLayers& pixel, LayerSet selection, std::vecto
                 break;
             case Layer::mirror:
                 store3(layers[next++], index, c.mirror);
+                break;
+            case Layer::transmission:
+                store3(layers[next++], index, c.transmission);
                 break;
             case Layer::background:
                 store3(layers[next++], index, c.background);

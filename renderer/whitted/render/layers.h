@@ -19,22 +19,23 @@ namespace whitted {
 /// The layers one can ask for, by their names in --layers and render.layers. `lights` stands for
 /// one layer per light, light1, light2, ... (1-based, file order).
 enum class Layer : uint32_t {
-    ambient,     ///< ka·Ia at the first hit
-    diffuse,     ///< Σ_i kd·I_i·max(0, n·l_i) at the first hit, over the unshadowed lights
-    specular,    ///< Σ_i ks·I_i·max(0, n·h_i)^p at the first hit
-    mirror,      ///< km·L(r) + kt·L(t): everything the first hit's mirror and refracted rays bring back, weighted
-    background,  ///< the background colour where the camera ray misses
-    lights,      ///< light<k>: light k's diffuse + specular at the first hit
-    N,           ///< shading normal at the first hit, turned toward the camera ray
-    Ng,          ///< geometric normal at the first hit, not turned
-    P,           ///< world-space first hit point
-    Z,           ///< camera ray distance t to the first hit; +inf on a miss
-    albedo,      ///< kd of the first hit's material
-    objectId,    ///< SceneObject number (1-based, file order) of the first hit; 0 on a miss
-    materialId,  ///< Scene::materials index + 1 of the first hit's material; 0 on a miss
-    hits,        ///< surface hits along the path (0 = the camera ray missed)
+    ambient,       ///< ka·Ia at the first hit
+    diffuse,       ///< Σ_i kd·I_i·max(0, n·l_i) at the first hit, over the unshadowed lights
+    specular,      ///< Σ_i ks·I_i·max(0, n·h_i)^p at the first hit
+    mirror,        ///< km·L(r): everything the first hit's mirror ray brings back, weighted
+    transmission,  ///< kt·L(t): everything the first hit's refracted ray brings back, weighted
+    background,    ///< the background colour where the camera ray misses
+    lights,        ///< light<k>: light k's diffuse + specular at the first hit
+    N,             ///< shading normal at the first hit, turned toward the camera ray
+    Ng,            ///< geometric normal at the first hit, not turned
+    P,             ///< world-space first hit point
+    Z,             ///< camera ray distance t to the first hit; +inf on a miss
+    albedo,        ///< kd of the first hit's material
+    objectId,      ///< SceneObject number (1-based, file order) of the first hit; 0 on a miss
+    materialId,    ///< Scene::materials index + 1 of the first hit's material; 0 on a miss
+    hits,          ///< surface hits along the path (0 = the camera ray missed)
 };
-inline constexpr int layer_kinds = 14;
+inline constexpr int layer_kinds = 15;
 
 const char* layer_name(Layer layer);
 std::optional<Layer> find_layer(const std::string& name);
@@ -56,7 +57,7 @@ LayerSet parse_layers(const std::vector<std::string>& names);
 
 /// The radiance of one camera ray split into the layers' terms, and its first hit's data.
 struct PathLayers {
-    Color ambient, diffuse, specular, mirror, background;
+    Color ambient, diffuse, specular, mirror, transmission, background;
     std::vector<Color> lights;  ///< one per light
     Vec3 N, Ng, P;
     double Z = 0;
@@ -78,12 +79,22 @@ public:
     void ambient(int lane, int level, const Color& ambient) override;
     void light(int lane, int level, size_t light, const LightTerms& terms) override;
     void local(int lane, int level, const Color& weight, const Color& local, const Color& added) override;
-    void mirror(int, int, const Ray&, const Color&) override {}
-    void transmitted(int, int, const Ray&, const Color&) override {}
+    void mirror(int lane, int level, const Ray&, const Color&) override;
+    void transmitted(int lane, int level, const Ray&, const Color&) override;
 
 private:
+    /// Where a lane's terms past the first hit go: the mirror or the transmission layer, by the
+    /// first hit's ray they come back along. The rays the first hit sends start their segments
+    /// last announced, first (depth first), so each segment at level 1 takes the latest.
+    /// A segment starts: at level 1, it takes the first hit's ray announced last.
+    void start_segment(int lane, int level);
+    Color& secondary(int lane) {
+        return m_in_transmission[size_t(lane)] ? m_lanes[lane].transmission : m_lanes[lane].mirror;
+    }
     const Scene& m_scene;
     std::vector<PathLayers> m_lanes;
+    std::vector<std::vector<bool>> m_announced;  ///< per lane: the first hit's rays not yet started (true: refracted)
+    std::vector<bool> m_in_transmission;
 };
 
 // ImageLayer, one layer of an image, is public: whitted/image.h.
@@ -102,7 +113,7 @@ struct PixelLayers {
 };
 
 /// Stores pixel `index`'s layers into `layers` (made by make_image_layers with `selection`) and
-/// its beauty into beauty[0..2]: the float sum ambient + diffuse + specular + mirror + background
+/// its beauty into beauty[0..2]: the float sum ambient + diffuse + specular + mirror + transmission + background
 /// of the layers' float values, in that order, so that the file's layers add up to its R, G, B
 /// bit for bit.
 void store_pixel_layers(const PixelLayers& pixel, LayerSet selection, std::vector<ImageLayer>& layers, size_t index,
