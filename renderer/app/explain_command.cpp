@@ -328,6 +328,9 @@ int run_explain(const std::string& scene_path, const std::string& pixel, bool js
             std::printf("%s\n", to_json(scene, scene_path, explanation).dump(2).c_str());
         else
             print_text(scene, scene_path, explanation);
+    } catch (const InputError& e) {  // e.g. a shape beyond the range the accelerator takes
+        print_error(e.what());
+        return exit_bad_input;
     } catch (const std::exception& e) {
         print_error(scene_path + ": " + e.what());
         return exit_failure;

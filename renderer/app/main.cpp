@@ -390,6 +390,9 @@ int run_render(const RenderArguments& args) {
                          result.stats.shadow_rays / 1e6, result.stats.reflected_rays / 1e6,
                          result.stats.seconds > 0 ? rays / result.stats.seconds / 1e6 : 0.0, args.output.c_str());
         return exit_ok;
+    } catch (const InputError& e) {  // e.g. a shape beyond the range the accelerator takes
+        print_error(e.what());
+        return exit_bad_input;
     } catch (const std::invalid_argument& e) {
         print_error(e.what());
         return exit_bad_input;

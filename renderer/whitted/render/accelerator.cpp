@@ -23,6 +23,7 @@
 
 #include <sys/mman.h>
 
+#include <cstdio>
 #include <tuple>
 
 #include <tbb/blocked_range.h>
@@ -380,6 +381,12 @@ void widen_triangles(const TriangleMesh& mesh, const Vec3& shift, double margin,
                     }
                 }
                 float* c3 = corners + 9 * t;
+                // A triangle of no area is never hit (the double test refuses it), and many of
+                // them at one point abort Embree's builder: NaN corners make Embree leave it out.
+                if (!(twice_area > 0)) {
+                    std::fill(c3, c3 + 9, std::numeric_limits<float>::quiet_NaN());
+                    continue;
+                }
                 for (int k = 0; k < 3; ++k) {
                     c3[3 * k] = float(p[k].x);
                     c3[3 * k + 1] = float(p[k].y);
@@ -688,6 +695,7 @@ struct Accelerator::Impl {
 
     Impl(const Scene& s, int threads, const std::string& instruction_set) : scene(s), isa(instruction_set) {
         spheres.scene = boxes.scene = cones.scene = &scene;
+        check_reach();  // before Embree holds anything
         // Embree gets the render's thread count (--threads): its setting limits the whole
         // process's TBB threads (with threads=1 the render ran at half speed), so the two must
         // agree.
@@ -743,6 +751,52 @@ struct Accelerator::Impl {
         tbb::collaborative_call_once(tie_order_built,
                                      [&] { tie_order_data = std::make_unique<PovrayTestOrder>(scene); });
         return *tie_order_data;
+    }
+
+    /// Embree keeps bounds and rays in float and stops the program (an assertion) on a ray whose
+    /// origin lies beyond about 1.8e19, or on bounds it cannot order; its rays start on the
+    /// shapes. So a finite shape reaching beyond ±max_reach is refused, naming the object.
+    static constexpr double max_reach = 1e15;
+    void check_reach() const {
+        const auto reach = [](const Vec3& lo, const Vec3& hi) {
+            return std::max(
+                {std::fabs(lo.x), std::fabs(lo.y), std::fabs(lo.z), std::fabs(hi.x), std::fabs(hi.y), std::fabs(hi.z)});
+        };
+        const auto check = [&](uint32_t object, double reached) {
+            if (reached <= max_reach) return;  // NaN is refused too
+            const SourceLocation where = object > 0 && object <= scene.objects.size()
+                                             ? scene.objects[object - 1].where
+                                             : SourceLocation{scene.path, 0, 0};
+            const char* kind =
+                object > 0 && object <= scene.objects.size() ? to_string(scene.objects[object - 1].type) : "object";
+            char distance[32];
+            std::snprintf(distance, sizeof distance, "%g", reached);
+            throw InputError(where, std::string(kind) + " reaches " + distance +
+                                        " from the origin in world space; Whitted renders shapes within 1e15 of it");
+        };
+        Vec3 lo, hi;
+        for (const Sphere& sphere : scene.spheres) world_bounds(sphere, lo, hi), check(sphere.object, reach(lo, hi));
+        for (const Box& box : scene.boxes) world_bounds(box, lo, hi), check(box.object, reach(lo, hi));
+        for (const Cone& cone : scene.cones) world_bounds(cone, lo, hi), check(cone.object, reach(lo, hi));
+        for (const TriangleMesh& mesh : scene.meshes) {
+            double reached = 0;
+            for (uint32_t i = 0; i < mesh.vertex_count(); ++i) {
+                const Vec3 v = vertex(mesh, i);
+                reached = std::max({reached, std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)});
+            }
+            check(mesh.object, reached);
+        }
+        for (const Instance& instance : scene.instances) {
+            const Prototype& prototype = scene.prototypes[instance.prototype];
+            double reached = 0;
+            for (int corner = 0; corner < 8; ++corner) {
+                const Vec3 p = instance.object_to_world.apply_point({corner & 1 ? prototype.hi.x : prototype.lo.x,
+                                                                     corner & 2 ? prototype.hi.y : prototype.lo.y,
+                                                                     corner & 4 ? prototype.hi.z : prototype.lo.z});
+                reached = std::max({reached, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+            }
+            check(instance.object, reached);
+        }
     }
 
     /// A BVH is built once per triangle and traversed once per ray. HIGH quality took 2.0 s to

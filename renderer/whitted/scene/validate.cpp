@@ -621,6 +621,19 @@ void make_window_camera(const CameraDescription& d, const Vec3& forward, Camera&
 }  // namespace
 
 Camera make_camera(const CameraDescription& d, int width, int height) {
+    // Rays start at the eye (or across an orthographic view), and Embree, in float, stops the
+    // program on a ray beyond about 1.8e19: refused with the scene's own range (accelerator.cpp).
+    constexpr double max_reach = 1e15;
+    const auto far = [](const Vec3& v) {
+        return !(std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}) <= max_reach);
+    };
+    if (far(d.eye.value))
+        fail(d.eye.where, "camera.eye is beyond 1e15 from the origin; Whitted renders scenes within it");
+    if (far(d.look_at.value))
+        fail(d.look_at.where, "camera.look_at is beyond 1e15 from the origin; Whitted renders scenes within it");
+    if (d.type.value == CameraType::orthographic &&
+        !(d.view_width.value <= max_reach && d.view_height.value <= max_reach))
+        fail(d.view_width.where, "camera: the orthographic view is wider than 1e15; Whitted renders scenes within it");
     const Vec3 view = d.look_at.value - d.eye.value;
     if (is_zero(view)) fail(d.look_at.where, "camera: look_at must differ from eye");
     if (is_zero(d.up.value)) fail(d.up.where, "camera.up must not be the zero vector");
