@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cmath>
 
 namespace whitted {
@@ -141,6 +142,80 @@ TEST(Shading, SchlickFresnelClosedForm) {
     EXPECT_DOUBLE_EQ(LectureShading::schlick_fresnel(r0, 0.0), 1.0);
     EXPECT_DOUBLE_EQ(LectureShading::schlick_fresnel(r0, 0.5), 0.04 + 0.96 * 0.03125);
     EXPECT_EQ(LectureShading::schlick_fresnel(r0, -0.1), 0.0);  // seen from behind
+}
+
+// The course's parser matches element names to its setters ignoring case: every element of a
+// scene written in lower, upper or mixed case reads as the scene in the course's own spelling.
+TEST(CourseXml, ElementNamesIgnoreCaseAsTheCoursesParserDoes) {
+    const char* const box_scene = R"(<?xml version="1.0"?>
+<scene>
+  <camera>
+    <viewPoint>5 4 3</viewPoint><viewDir>-5 -4 -3</viewDir><viewUp>0 1 0</viewUp>
+    <projNormal>5 4 3</projNormal><projDistance>5</projDistance><viewWidth>2.5</viewWidth><viewHeight>2</viewHeight>
+  </camera>
+  <image>30 20</image>
+  <samples>4</samples>
+  <shader name="red" type="Phong"><diffuseColor>.8 .2 .1</diffuseColor><specularColor>.5 .5 .5</specularColor><exponent>20</exponent></shader>
+  <shader name="glaze" type="Glazed"><refractiveIndex>1.5</refractiveIndex><substrate type="Lambertian"><diffuseColor>.2 .3 .8</diffuseColor></substrate></shader>
+  <surface type="Box"><shader ref="red" /><minPt>-1 -1 -1</minPt><maxPt>1 1 1</maxPt></surface>
+  <surface type="Group"><translate>1 0 0</translate><rotate>0 30 0</rotate><scale>1 2 1</scale>
+    <surface type="Sphere"><shader ref="glaze" /><center>0 1 0</center><radius>0.5</radius></surface>
+  </surface>
+  <light><position>3 4 5</position><intensity>1 1 1</intensity></light>
+</scene>
+)";
+    const SceneDescription canonical = parse_course_xml_text(box_scene, "c.xml");
+    const auto respelled = [&](auto change) {
+        std::string text = box_scene;
+        std::string out;
+        for (size_t i = 0; i < text.size(); ++i) {
+            out += text[i];
+            if (text[i] != '<' || i + 1 >= text.size() || text[i + 1] == '?') continue;
+            size_t j = i + 1;
+            if (text[j] == '/') out += text[j++];
+            const size_t end = text.find_first_of(" />", j);
+            out += change(text.substr(j, end - j));
+            i = end - 1;
+        }
+        return out;
+    };
+    const auto lower = [](std::string w) {
+        for (char& c : w) c = char(std::tolower(static_cast<unsigned char>(c)));
+        return w;
+    };
+    const auto upper = [](std::string w) {
+        for (char& c : w) c = char(std::toupper(static_cast<unsigned char>(c)));
+        return w;
+    };
+    const auto mixed = [](std::string w) {
+        for (size_t k = 0; k < w.size(); k += 2) w[k] = char(std::toupper(static_cast<unsigned char>(w[k])));
+        return w;
+    };
+    for (const std::string& text : {respelled(lower), respelled(upper), respelled(mixed)}) {
+        ASSERT_NE(text, box_scene);
+        const SceneDescription d = parse_course_xml_text(text, "c.xml");
+        EXPECT_EQ(d.camera.eye.value, canonical.camera.eye.value);
+        EXPECT_EQ(d.camera.image_plane_normal.value, canonical.camera.image_plane_normal.value);
+        EXPECT_EQ(d.camera.view_height.value, canonical.camera.view_height.value);
+        EXPECT_EQ(d.image.samples.value, canonical.image.samples.value);
+        ASSERT_EQ(d.materials.size(), canonical.materials.size());
+        EXPECT_EQ(d.materials[0].ks.value, canonical.materials[0].ks.value);
+        EXPECT_EQ(d.materials[1].fresnel_ior.value, canonical.materials[1].fresnel_ior.value);
+        ASSERT_EQ(d.objects.size(), canonical.objects.size());
+        EXPECT_EQ(d.objects[0].max.value, canonical.objects[0].max.value);
+        ASSERT_EQ(d.objects[1].children.size(), 1u);
+        EXPECT_EQ(d.objects[1].transform.size(), canonical.objects[1].transform.size());
+        EXPECT_EQ(d.objects[1].children[0].radius.value, canonical.objects[1].children[0].radius.value);
+        EXPECT_EQ(d.lights[0].position.value, canonical.lights[0].position.value);
+    }
+    // A name that is no element in any case is still refused, with its place and a suggestion.
+    try {
+        parse_course_xml_text(respelled([](std::string w) { return w == "radius" ? std::string("radios") : w; }),
+                              "c.xml");
+        ADD_FAILURE() << "<radios> accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("unknown element <radios>"), std::string::npos) << e.what();
+    }
 }
 
 }  // namespace
