@@ -256,7 +256,7 @@ private:
                 break;
             case ObjectType::plane: {
                 // World-space plane computed exactly as Whitted does; POV's `plane { n, d }` is n·x = d.
-                const Vec3 normal = normalize(to_world.apply_normal(object.normal.value));
+                const Vec3 normal = unit_direction(to_world.apply_normal(object.normal.value));
                 const Vec3 point = to_world.apply_point(object.point.value);
                 m_out += "plane { " + vec(normal) + ", " + num(dot(normal, point)) + "\n    " +
                          texture(material_of(object)) + " }\n";
@@ -526,7 +526,7 @@ static std::string write_sdl(const SceneDescription& d, const ConvertOptions& op
         } else {
             // A parallel light aimed at the origin from directional_light_distance away: POV-Ray
             // then limits shadow rays exactly as Whitted does (ray.h).
-            const Vec3 toward_light = -normalize(light.direction.value);
+            const Vec3 toward_light = -unit_direction(light.direction.value);
             o += "light_source { " + vec(toward_light * ray_limits::directional_light_distance) + " color " +
                  rgb(intensity) + " parallel point_at <0, 0, 0> }\n";
         }

@@ -99,6 +99,16 @@ inline double length(const Vec3& v) {
 inline Vec3 normalize(const Vec3& v) {
     return v / length(v);
 }
+/// normalize(v), also for a direction whose squared length under- or overflows a double (any
+/// non-zero length is a direction, [0, 4.9e-324, 0] too): such a v is first divided by its
+/// largest component. Every other v gives normalize(v) bit for bit.
+inline Vec3 unit_direction(const Vec3& v) {
+    const double len = length(v);
+    if (len > 1e-150 && len < 1e150) return v / len;
+    const double largest = std::fmax(std::fabs(v.x), std::fmax(std::fabs(v.y), std::fabs(v.z)));
+    const Vec3 scaled = v / largest;
+    return scaled / length(scaled);
+}
 inline Vec3 min(const Vec3& a, const Vec3& b) {
     return {std::fmin(a.x, b.x), std::fmin(a.y, b.y), std::fmin(a.z, b.z)};
 }

@@ -263,7 +263,7 @@ private:
             }
             case ObjectType::plane: {
                 require_non_zero(object.normal, "plane.normal");
-                const Vec3 normal = normalize(to_world.apply_normal(object.normal.value));
+                const Vec3 normal = unit_direction(to_world.apply_normal(object.normal.value));
                 m_scene.planes.push_back(
                     {to_world.apply_point(object.point.value), normal, resolve_material(object), add_id(object)});
                 break;
@@ -721,7 +721,7 @@ void validate_settings(const SceneDescription& d, Scene& scene) {
             out.position = light.position.value;
         } else {
             require_non_zero(light.direction, what + ".direction");
-            out.toward_light = -normalize(light.direction.value);
+            out.toward_light = -unit_direction(light.direction.value);
         }
         scene.lights.push_back(out);
     }
