@@ -33,6 +33,15 @@ def read_exr(path):
     return spec, pixels
 
 
+def child_python_env():
+    """The environment for a child python3 that imports the module: in the sanitizer build the
+    ASan runtime must be preloaded again (conftest.py took it out of this process's LD_PRELOAD)."""
+    env = dict(os.environ)
+    if os.environ.get("WHITTED_TEST_PYTHON_PRELOAD"):
+        env["LD_PRELOAD"] = os.environ["WHITTED_TEST_PYTHON_PRELOAD"]
+    return env
+
+
 def big_scene(samples=8, size=2000):
     """Several hundred million camera rays: a minute or more, far longer than any test waits."""
     return (whitted.SceneBuilder().image(size, size, samples).camera([0, 0, 5], [0, 0, 0])
@@ -137,10 +146,8 @@ def test_sigint_stops_a_render_within_a_second(tmp_path):
             sys.exit(42)
         print("finished", flush=True)
     """)
-    env = dict(os.environ)
-    if os.environ.get("WHITTED_TEST_PYTHON_PRELOAD"):  # the sanitizer build (conftest.py)
-        env["LD_PRELOAD"] = os.environ["WHITTED_TEST_PYTHON_PRELOAD"]
-    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=env)
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True,
+                            env=child_python_env())
     assert proc.stdout.readline().strip() == "rendering"
     time.sleep(0.5)  # well inside the render
     sent = time.monotonic()
@@ -236,7 +243,8 @@ def test_every_error_path_raises(case, tmp_path):
         else:
             print('NOTHING RAISED')
     """)
-    result = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True, timeout=120)
+    result = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True, timeout=120,
+                            env=child_python_env())
     assert result.returncode == 0, f"{case}: exit {result.returncode}\n{result.stderr[-2000:]}"
     kind = result.stdout.split()[0] if result.stdout.split() else ""
     assert kind == expected, f"{case}: {result.stdout}{result.stderr[-2000:]}"

@@ -197,8 +197,8 @@ TEST(Layers, RefractedRaysFillTheTransmissionLayer) {
             float sum = 0.0f;
             for (int l = 0; l < 6; ++l) sum += result.image.layers[size_t(l)].values[3 * p + c];
             ASSERT_EQ(sum, result.image.rgb[3 * p + c]) << "pixel " << p;
-            transmitted += result.image.layers[4].values[3 * p + c];
-            mirrored += result.image.layers[3].values[3 * p + c];
+            transmitted += double(result.image.layers[4].values[3 * p + c]);
+            mirrored += double(result.image.layers[3].values[3 * p + c]);
         }
     EXPECT_GT(transmitted, 2 * mirrored);  // kt 0.8 against km 0.1
     EXPECT_GT(mirrored, 0);
