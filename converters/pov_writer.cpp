@@ -324,14 +324,12 @@ private:
     }
 
     /// A mesh2 in world space: vertices and normals transformed in double exactly as Whitted
-    /// does before both store them as float, so the two renderers see the same triangles.
-    /// A mesh far from the origin is written about a centre of its own and moved there with
-    /// `translate`: POV-Ray keeps each triangle's plane as a float normal and a float distance
-    /// from the origin, which far out is too coarse (spaced 1e-3 at 1e4) and gave POV-Ray
-    /// self-shadowing speckles; about the centre the distances are small, and the ray is moved
-    /// into the mesh's frame in double. The triangles are unchanged: each vertex minus the
-    /// centre is exact in float (checked, axis by axis), so centre + vertex is the same float
-    /// vertex Whitted uses.
+    /// does, written about the point Whitted stores the mesh about (mesh_origin, scene.h) as the
+    /// floats Whitted keeps, and moved there with `translate`: so the two renderers see the same
+    /// triangles. About its own centre a far mesh also keeps its precision in POV-Ray, which
+    /// holds each triangle's plane as a float normal and a float distance from the mesh's origin
+    /// (spaced 1e-3 at 1e4 in world coordinates: self-shadowing speckles); the ray is moved into
+    /// the mesh's frame in double.
     void mesh(const std::vector<Vec3>& vertices, const std::vector<Vec3>& normals,
               const std::vector<std::array<int64_t, 3>>& triangles, const Transform& to_world,
               const std::optional<Material>& material) {
@@ -339,15 +337,21 @@ private:
         // instance gives its own.
         std::string piece;
         std::string& o = m_collect ? piece : m_out;
-        std::vector<Vec3> world;  // the float vertices, as doubles
+        std::vector<Vec3> world;
         world.reserve(vertices.size());
+        constexpr double inf = std::numeric_limits<double>::infinity();
+        Vec3 lo(inf), hi(-inf);
         for (const Vec3& v : vertices) {
-            const Vec3 w = to_world.apply_point(v);
-            world.push_back({float_rounded(w.x), float_rounded(w.y), float_rounded(w.z)});
+            world.push_back(to_world.apply_point(v));
+            lo = min(lo, world.back()), hi = max(hi, world.back());
         }
-        const Vec3 centre = povray_mesh_centre(world.size(), [&](size_t i) { return world[i]; });
+        const Vec3 centre = mesh_origin(lo, hi);
+        for (Vec3& w : world) {
+            const Vec3 offset = w - centre;
+            w = {float_rounded(offset.x), float_rounded(offset.y), float_rounded(offset.z)};  // the stored floats
+        }
         o += "mesh2 {\n  vertex_vectors { " + std::to_string(vertices.size());
-        for (const Vec3& w : world) o += ",\n    " + vec(w - centre);
+        for (const Vec3& w : world) o += ",\n    " + vec(w);
         o += " }\n";
         if (!normals.empty()) {
             o += "  normal_vectors { " + std::to_string(normals.size());

@@ -241,6 +241,8 @@ nlohmann::json metrics_json(const std::string& scene_path, const CheckResult& r,
                          {"povray", rgb_json(w.theirs)}});
     j["worst_pixels"] = worst;  // largest error first, at most CheckOptions::worst_count
     j["whitted_seconds"] = r.whitted_seconds;
+    // The intersection rules Whitted rendered with (docs/scene-format.md, render.intersection).
+    j["whitted_intersection"] = "povray";
     j["povray_seconds"] = r.povray_seconds;
     j["povray_runs"] = r.povray_runs;
     j["povray_program"] = r.povray_program;
@@ -436,6 +438,8 @@ kbd { border: 1px solid #bbb; border-radius: 3px; padding: 0 .25em; font-size: .
     row("render time", fmt::format("Whitted {:.3f} s; POV-Ray {:.2f} s ({} run{})", r.whitted_seconds, r.povray_seconds,
                                    r.povray_runs, r.povray_runs == 1 ? "" : "s"));
     row("POV-Ray", "<code>" + html_escape(r.povray_program) + "</code>");
+    row("Whitted's intersection",
+        "<code>render.intersection: povray</code> (POV-Ray's decisions at edges, grazes and ties)");
     h += "</table>\n";
 
     h += fmt::format("<h2>The {} worst pixels</h2>\n", c.worst.size());

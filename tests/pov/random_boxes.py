@@ -10,7 +10,9 @@ the floor's plane: Whitted gave that bottom the hit and POV-Ray the floor, 1,147
 until a plane took such a tie (accelerator.cpp, finish_hit). Coordinates keep 7 decimals, or
 DECIMALS: with 3 (written as random_boxes_3.json), overlapping boxes share faces, met at exactly
 the same t, and Whitted must show the box POV-Ray shows (PovrayTestOrder; seed 1 failed the cap
-by 14,831 codes before, docs/validation.md, Known differences).
+by 14,831 codes before, docs/validation.md, Known differences). The scene asks for POV-Ray's
+intersection rules (render.intersection: povray), which `whitted check` renders with anyway, so
+that `whitted render` of it gives the image `check` compares.
 Usage: random_boxes.py OUT_DIR [N] [SEED] [DECIMALS]"""
 import json
 import random
@@ -43,7 +45,7 @@ def scene(n: int, seed: int, decimals: int = 7) -> dict:
                                           {"translate": [round(x, decimals), r * 1.5, round(z, decimals)]}]})
     return {"image": {"width": 400, "height": 300, "samples": 2, "background": [0.02, 0.03, 0.05]},
             "camera": {"eye": [0, 12, 24], "look_at": [0, 0, -2], "up": [0, 1, 0], "fov": 60},
-            "render": {"max_depth": 3},
+            "render": {"max_depth": 3, "intersection": "povray"},
             "lights": [{"type": "point", "position": [-10, 20, 10], "intensity": 0.7},
                        {"type": "directional", "direction": [0.3, -1, -0.2], "intensity": 0.4}],
             "materials": {"floor": {"kd": 0.6, "ka": 0.05, "km": 0.25},

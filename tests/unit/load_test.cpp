@@ -263,5 +263,50 @@ TEST(LoadScene, AnUntransformedSphereCarriesNoTransform) {
     EXPECT_LE(sizeof(Sphere), 64u);
 }
 
+// render.intersection: exact by default, povray when asked, anything else refused where written.
+TEST(LoadScene, IntersectionRulesAreExactUnlessPovrayIsAsked) {
+    const std::string sphere = "objects: [{ type: sphere, center: [0, 0, 0], radius: 1, material: { kd: 0.5 } }]";
+    EXPECT_EQ(test::scene_from(scene_text({sphere})).intersection, Intersection::exact);
+    EXPECT_EQ(test::scene_from(scene_text({"render: { intersection: exact }", sphere})).intersection,
+              Intersection::exact);
+    EXPECT_EQ(load_scene_text(scene_text({"render: { intersection: povray }", sphere}), "s.yaml").intersection,
+              Intersection::povray);
+    const auto error = test::scene_error(scene_text({"render: { intersection: POVRay }", sphere}));
+    ASSERT_TRUE(error);
+    EXPECT_EQ(error->where().line, 3);
+    EXPECT_EQ(error->where().column, 25);
+    EXPECT_THAT(error->what(), ::testing::HasSubstr("exact"));
+    EXPECT_THAT(error->what(), ::testing::HasSubstr("povray"));
+}
+
+// A mesh is stored about the centre of its bounds once that lies further out than its half
+// extent (mesh_origin): moved anywhere, by any amount, it keeps the very float offsets it has
+// about its centre, and a mesh around the origin keeps its world coordinates as floats.
+TEST(LoadScene, AMeshKeepsItsFloatsWhereverItIsMoved) {
+    const auto mesh_at = [&](const Vec3& shift) {
+        char line[400];
+        std::snprintf(line, sizeof line,
+                      "objects: [{ type: group, transform: [{ translate: [%.17g, %.17g, %.17g] }], objects: [{ type: "
+                      "mesh, material: { kd: 0.5 }, triangles: [[0, 1, 2]], vertices: [[2.3, 1.1, 0.7], [3.9, 1.6, "
+                      "0.2], [2.9, 2.7, 1.3]] }] }]",
+                      shift.x, shift.y, shift.z);
+        return test::scene_from(scene_text({line})).meshes.at(0);
+    };
+    const TriangleMesh here = mesh_at({0, 0, 0});
+    EXPECT_EQ(here.origin, Vec3(2.3 + 3.9, 1.1 + 2.7, 0.2 + 1.3) * 0.5);  // the centre of its bounds
+    for (const double t : {170.0, 3.7e4, 1.1e6, -2.9e5}) {
+        const TriangleMesh moved = mesh_at(Vec3{1, -0.61, 0.37} * t);
+        EXPECT_EQ(moved.positions, here.positions) << t;
+        EXPECT_NEAR(moved.origin.x, here.origin.x + t, 1e-9 * std::fabs(t)) << t;
+    }
+    const TriangleMesh around =
+        test::scene_from(scene_text({"objects: [{ type: mesh, material: { kd: 0.5 }, triangles: [[0, 1, 2]], vertices: "
+                                     "[[-1.3, 0.1, 0.2], [0.9, "
+                                     "-0.6, 0.2], [0.3, 1.7, -0.4]] }]"}))
+            .meshes.at(0);
+    EXPECT_EQ(around.origin, Vec3(0.0));
+    EXPECT_EQ(around.positions[0], float(-1.3));
+}
+
 }  // namespace
 }  // namespace whitted

@@ -89,31 +89,37 @@ TEST(PovWriter, LightsAndObjectsShareOneLightGroup) {
     EXPECT_EQ(count_of(sdl_for("lights: [{type: point, position: [1, 2, 3]}]\n"), "light_group"), 0u);
 }
 
-// A mesh far from the origin is written about a centre of its own plus `translate`, so that
-// POV-Ray's float plane distances stay small; centre + written vertex must be exactly the float
-// world vertex Whitted renders. A mesh near the origin is written as it is, with no translate.
-TEST(PovWriter, FarMeshWrittenAboutItsOwnCentreWithTheSameFloatVertices) {
+// A mesh far from the origin (further than its half extent) is written about the centre of its
+// bounds plus `translate`, so that POV-Ray's float plane distances stay small; the written
+// vertices are exactly the float offsets Whitted stores (mesh_origin). A mesh around the origin
+// is written as it is, with no translate.
+TEST(PovWriter, FarMeshWrittenAboutItsOwnCentreWithTheFloatOffsetsWhittedStores) {
     const std::vector<Vec3> far{
         {100000.3, 70000.7, -40000.1}, {100001.9, 70000.2, -39999.5}, {99999.1, 70002.6, -40000.9}};
     std::string mesh = "objects:\n  - {type: mesh, material: {kd: 0.5}, triangles: [[0, 1, 2]], vertices: [";
     for (const Vec3& v : far) mesh += fmt_vec(v) + (&v == &far.back() ? "" : ", ");
     mesh += "]}\n";
     const std::string sdl = sdl_for(mesh);
+    // About the centre of the mesh's bounds (mesh_origin), written exactly, as Whitted stores it.
     const auto centre = numbers_after(sdl, "translate", 3);
     ASSERT_EQ(centre.size(), 3u);
-    for (double c : centre) EXPECT_EQ(double(float(c)), c);  // the centre itself is a float
+    for (int axis = 0; axis < 3; ++axis) {
+        double lo = far[0][axis], hi = far[0][axis];
+        for (const Vec3& v : far) lo = std::min(lo, v[axis]), hi = std::max(hi, v[axis]);
+        EXPECT_EQ(centre[size_t(axis)], 0.5 * (lo + hi)) << "axis " << axis;
+    }
     const auto written = numbers_after(sdl, "vertex_vectors { 3,", 9);
     for (size_t i = 0; i < 3; ++i) {
         for (int axis = 0; axis < 3; ++axis) {
             const double local = written[3 * i + axis];
             EXPECT_EQ(double(float(local)), local);  // POV-Ray stores it as this float exactly
-            EXPECT_EQ(local + centre[axis], double(float(far[i][axis]))) << "vertex " << i << " axis " << axis;
+            EXPECT_EQ(local, double(float(far[i][axis] - centre[size_t(axis)]))) << "vertex " << i << " axis " << axis;
             EXPECT_LT(std::fabs(local), 4.0);
         }
     }
     const std::string near = sdl_for(
         "objects:\n  - {type: mesh, material: {kd: 0.5}, triangles: [[0, 1, 2]], "
-        "vertices: [[0.3, 0.7, -0.1], [1.9, 0.2, 0.5], [-0.9, 2.6, -0.9]]}\n");
+        "vertices: [[0.3, 0.7, -0.1], [1.9, -0.2, 0.5], [-0.9, 1.6, -0.9]]}\n");
     EXPECT_THAT(near, Not(HasSubstr("translate")));
     EXPECT_EQ(numbers_after(near, "vertex_vectors { 3,", 3),
               (std::vector<double>{float(0.3), float(0.7), float(-0.1)}));

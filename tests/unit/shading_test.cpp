@@ -54,8 +54,11 @@ Light directional_light(const Vec3& direction, const Color& intensity) {
 }
 
 Color trace_from(const Scene& scene, const Vec3& origin, const Vec3& target) {
-    const Accelerator accelerator(scene);
-    const LectureShading shading(scene, accelerator);
+    // The ray leaves the camera: the exact rule's windows (RaySpans) measure from the eye.
+    Scene placed = scene;
+    placed.camera.eye = origin;
+    const Accelerator accelerator(placed);
+    const LectureShading shading(placed, accelerator);
     RayCounts counts;
     return shading.trace({origin, normalize(target - origin), 1e-4, 1e7}, 0, counts);
 }

@@ -151,12 +151,13 @@ TEST(Box, MissesParallelOutsideSlabAndBehind) {
 // is reported on the −x face if that is more than 1e-6 away in t, and otherwise on the face the
 // ray runs more steeply along (the top, for a steep ray; still −x for a shallow one), at the t
 // of the crossing held first (x's). Closed form: the ray passes through (−1, 1 − δ, 0.25).
+// This is render.intersection: povray (what `whitted check` renders with).
 TEST(Box, NearAnEdgeTheFaceFollowsPovRaysRule) {
     const Box box{nullptr, {-1, -1, -1}, {1, 1, 1}, 0};
     const auto hit_at = [&](double dx, double dy, double delta, ShapeHit& hit) {
         const Vec3 d = normalize(Vec3{dx, -dy, 0});
         const Vec3 on_face{-1, 1 - delta, 0.25};
-        return intersect_box(box, ray_from(on_face - d * 4, d), t_min, t_max, hit);
+        return intersect_box(box, ray_from(on_face - d * 4, d), t_min, t_max, hit, Intersection::povray);
     };
     ShapeHit hit;
     // Steep (|d.y| = 2|d.x|): crossings δ/|d.y| apart.
@@ -173,9 +174,33 @@ TEST(Box, NearAnEdgeTheFaceFollowsPovRaysRule) {
     // +z face 1e-7 inside the +x edge is reported on +z if |d.z| > |d.x|.
     const Vec3 d = normalize(Vec3{-1, 0, -3});
     const Vec3 on_face{1 - 1e-7, 0.5, 1};
-    ASSERT_TRUE(intersect_box(box, ray_from(on_face - d * 4, d), t_min, t_max, hit));
+    ASSERT_TRUE(intersect_box(box, ray_from(on_face - d * 4, d), t_min, t_max, hit, Intersection::povray));
     expect_vec_near(hit.normal, {0, 0, 1}, 0.0);
     EXPECT_NEAR(hit.t, 4 - 1e-7 * std::sqrt(10.0), 1e-9);  // x's crossing, held first
+}
+
+// The exact rule (the default): the face is the one the ray really crosses, however close to the
+// edge, and a ray exactly through an edge gets the face of the later axis. Scaled by k, the box
+// and the ray give the same faces and k times the distances: no constant in t.
+TEST(Box, ExactlyTheFaceIsTheOneTheRayCrosses) {
+    for (const double k : {1e-3, 0.37, 1.0, 47.0, 1e3}) {
+        const Box box{nullptr, {-k, -k, -k}, {k, k, k}, 0};
+        const auto hit_at = [&](double dx, double dy, double delta, ShapeHit& hit) {
+            const Vec3 d = normalize(Vec3{dx, -dy, 0});
+            const Vec3 on_face = Vec3{-1, 1 - delta, 0.25} * k;
+            return intersect_box(box, {on_face - d * (4 * k), d, 0, 1e16}, 0, 1e16, hit);
+        };
+        ShapeHit hit;
+        for (const double delta : {1e-3, 1e-7, 1e-12}) {
+            ASSERT_TRUE(hit_at(1, 2, delta, hit)) << k;  // the −x face, δ below its top edge
+            expect_vec_near(hit.normal, {-1, 0, 0}, 0.0);
+            EXPECT_NEAR(hit.t, 4 * k, 1e-12 * k);
+        }
+        // Through the edge itself (δ = 0): the top face, y's crossing coming after x's.
+        ASSERT_TRUE(hit_at(1, 1, 0, hit)) << k;
+        expect_vec_near(hit.normal, {0, 1, 0}, 0.0);
+        EXPECT_NEAR(hit.t, 4 * k, 1e-12 * k);
+    }
 }
 
 // A box turned 90° about z: its object x face now faces world +y, with the normal carried along.

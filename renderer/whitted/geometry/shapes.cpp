@@ -78,13 +78,16 @@ bool steeper_face(int axis, BoxFace held, const Vec3& direction) {
 
 }  // namespace
 
-bool intersect_box(const Box& box, const Ray& world_ray, double t_min, double t_max, ShapeHit& hit) {
+bool intersect_box(const Box& box, const Ray& world_ray, double t_min, double t_max, ShapeHit& hit, Intersection rule) {
     const Ray ray = to_object_space(transform_of(box.object_to_world), world_ray);
-    // The slab test, axis by axis in the order x, y, z, with POV-Ray's constants: a direction
+    // The slab test, axis by axis in the order x, y, z. With POV-Ray's constants: a direction
     // component within 1e-10 of 0 is parallel to its slab; crossings within 1e-6 of each other
     // are one crossing (the t already held is kept, the face may change, steeper_face); the
-    // span starts at t = 0, and an exit before 1e-6 is no hit.
-    constexpr double parallel = 1e-10, close = 1e-6, depth_tolerance = 1e-6;
+    // span starts at t = 0, and an exit before 1e-6 is no hit. Exactly, all three are 0: they
+    // are distances in t, which scaling the scene scales, so they would make its image depend on
+    // its size.
+    const bool povray = rule == Intersection::povray;
+    const double parallel = povray ? 1e-10 : 0.0, close = povray ? 1e-6 : 0.0, depth_tolerance = povray ? 1e-6 : 0.0;
     double t_in = 0, t_out = std::numeric_limits<double>::infinity();
     BoxFace face_in = -1, face_out = -1;
     bool tie_in = false, tie_out = false;  // the face was switched by the edge rule
@@ -103,13 +106,13 @@ bool intersect_box(const Box& box, const Ray& world_ray, double t_min, double t_
         const double tie = axis == 0 ? 0.0 : close;  // the first axis has nothing to tie with
         if (t_exit <= t_out - tie) {
             t_out = t_exit, face_out = exit_face, tie_out = false;
-        } else if (t_exit <= t_out + tie && steeper_face(axis, face_out, ray.direction)) {
+        } else if (povray && t_exit <= t_out + tie && steeper_face(axis, face_out, ray.direction)) {
             face_out = exit_face, tie_out = true;
         }
         if (t_entry >= t_in + tie) {
             if (t_entry > t_out) return false;
             t_in = t_entry, face_in = entry_face, tie_in = false;
-        } else if (t_entry >= t_in - tie && axis > 0 && steeper_face(axis, face_in, ray.direction)) {
+        } else if (povray && t_entry >= t_in - tie && axis > 0 && steeper_face(axis, face_in, ray.direction)) {
             face_in = entry_face, tie_in = true;
         }
     }

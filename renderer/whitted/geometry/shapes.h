@@ -21,7 +21,11 @@ struct ShapeHit {
 };
 
 bool intersect_sphere(const Sphere& sphere, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
-bool intersect_box(const Box& box, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
+/// The slab test. `rule` exact: no tolerance but t_min; a ray through an edge or corner gets the
+/// face of the last axis it crosses there. `rule` povray: POV-Ray 3.7's constants and edge rule
+/// (docs/pov-model.md §3, "Box edges"), for `whitted check`.
+bool intersect_box(const Box& box, const Ray& ray, double t_min, double t_max, ShapeHit& hit,
+                   Intersection rule = Intersection::exact);
 /// The side as a quadric in the cone's own frame (the axis and the plane across it), then the
 /// caps as discs unless the cone is open; the nearest hit. Exact in double: no tolerance but
 /// t_min. The side's normal is the gradient of |p⊥| − r(s), scaled by r(s).

@@ -105,7 +105,7 @@ bool intersect_analytic(const AnalyticGeometry& geometry, unsigned prim, const R
         return intersect_sphere(geometry.scene->spheres[prim], ray, ray.t_min, t_max, hit);
     if (geometry.kind == ShapeKind::cones)
         return intersect_cone(geometry.scene->cones[prim], ray, ray.t_min, t_max, hit);
-    return intersect_box(geometry.scene->boxes[prim], ray, ray.t_min, t_max, hit);
+    return intersect_box(geometry.scene->boxes[prim], ray, ray.t_min, t_max, hit, geometry.scene->intersection);
 }
 
 /// Whether Scene::objects number `object` (index + 1) is a cylinder or cone.
@@ -158,16 +158,15 @@ void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
             // An exact tie with the sphere or box held: overlapping boxes with faces in one
             // plane, or two equal spheres in one place.
             const Vec3& held = context->best_normal[id];
-            // POV-Ray's order (PovrayTestOrder) knows spheres and boxes; a tie with a cone goes,
-            // like a tie that looks the same, to the first object in the file, whatever order
-            // Embree met them in.
-            const bool with_cone =
-                geometry->kind == ShapeKind::cones || is_cone_object(*geometry->scene, context->best_object[id]);
-            if (with_cone || (material == context->best_material[id] && hit.normal.x == held.x &&
+            // The exact rule: the tie goes to the first object in the file, whatever order
+            // Embree met them in (which differs from one instruction set to another). So does a
+            // tie with a cone, and a tie that looks the same, under POV-Ray's rules too: its
+            // order (PovrayTestOrder) knows spheres and boxes.
+            const bool by_object = geometry->scene->intersection == Intersection::exact ||
+                                   geometry->kind == ShapeKind::cones ||
+                                   is_cone_object(*geometry->scene, context->best_object[id]);
+            if (by_object || (material == context->best_material[id] && hit.normal.x == held.x &&
                               hit.normal.y == held.y && hit.normal.z == held.z)) {
-                // The two look the same; which one is kept shows only in the objectId layer:
-                // the first in the file, whatever order Embree met them in (which differs from
-                // one instruction set to another).
                 if (object > context->best_object[id]) continue;
             } else {
                 // A plain face at the same t replaces a face the edge rule chose (a ray along
@@ -217,12 +216,23 @@ void analytic_occluded(const RTCOccludedFunctionNArguments* args) {
 }
 
 Vec3 vertex(const TriangleMesh& mesh, uint32_t index) {
-    const float* p = &mesh.positions[4 * size_t(index)];
-    return {p[0], p[1], p[2]};
+    return mesh.vertex(index);
+}
+
+/// How far apart two surfaces a ray meets at `t` may be found and still be one tie by the exact
+/// rule (render.intersection: exact): 64 ulps of the largest coordinate or distance the two
+/// distances were computed from. A face lying in a plane is met by both at one t in real
+/// numbers, but each distance is rounded its own way; scaled or moved, the rounding differs,
+/// and without the window the order of the two would follow it.
+double tie_window(const Ray& ray, double t) {
+    const Vec3 x = ray.at(t);
+    const double largest = std::max({std::fabs(ray.origin.x), std::fabs(ray.origin.y), std::fabs(ray.origin.z),
+                                     std::fabs(x.x), std::fabs(x.y), std::fabs(x.z), std::fabs(t)});
+    return 64 * std::numeric_limits<double>::epsilon() * largest;
 }
 
 /// What triangle_filter needs of a mesh: its triangles, how they are decided
-/// (decided_as_povray) and, for a prototype's mesh, the transform of each instance (by
+/// (MeshAsPovray) and, for a prototype's mesh, the transform of each instance (by
 /// Embree's instance geomID), to take the ray into its space.
 struct TriangleGeometry {
     const TriangleMesh* mesh = nullptr;
@@ -235,32 +245,26 @@ struct TriangleGeometry {
 /// a ray along an edge two triangles share meets at least one of them.
 constexpr double triangle_edge_margin = 1e-10;
 
-/// Whether the triangles of `mesh` are decided by POV-Ray's own test (intersect_mesh2_triangle,
-/// mesh2_smooth_normal), the renderer the cross-check compares with. The exact test differs
-/// from it where a ray grazes a triangle (POV-Ray's single-precision plane moves the hit along
-/// the ray by up to 5e-3, past the shadow window) or passes within about 1e-9 of an edge
-/// (POV-Ray's float planes of two neighbours can leave a crack between them, or overlap): the
-/// instancing bench tori and the 1M-triangle anchor failed the strict rule at such pixels
-/// (docs/pov-model.md §3, "Mesh triangles"; docs/validation.md, "Grazing rays on the
-/// instancing bench tori"). POV-Ray's test needs the mesh as POV-Ray reads
-/// it; `whitted convert` writes a mesh whose coordinates reach 16 on some axis about a centre
-/// of its own (pov_writer.cpp, mesh_centre), and such a mesh, whose plane distances POV-Ray
-/// holds in that frame, is decided by the exact test (Möller–Trumbore in double).
-bool decided_as_povray(const TriangleMesh& mesh) {
-    constexpr float moved_by_the_converter = 16;
-    for (size_t i = 0; i < mesh.positions.size(); i += 4)
-        if (!(std::fabs(mesh.positions[i]) < moved_by_the_converter &&
-              std::fabs(mesh.positions[i + 1]) < moved_by_the_converter &&
-              std::fabs(mesh.positions[i + 2]) < moved_by_the_converter))
-            return false;
-    return true;
+/// Vertex `index` of `mesh` as its float offset from TriangleMesh::origin: the vertex as the
+/// mesh2 `whitted convert` writes holds it, about that origin (moved there by `translate`).
+Vec3 offset_vertex(const TriangleMesh& mesh, uint32_t index) {
+    const float* p = &mesh.positions[4 * size_t(index)];
+    return {p[0], p[1], p[2]};
 }
 
 /// The decision on a triangle candidate, made in double from the scene's own float vertices
 /// and the double ray: the ray passes inside the triangle and meets it within (t_min, t_max),
-/// by POV-Ray's test where `as_povray` (decided_as_povray; for a prototype's triangle,
-/// `instanced`: the ray is in the prototype's space with the world's t, and POV-Ray makes its
-/// direction unit length first), else by the exact one. Embree's float test only proposes
+/// by the exact test (Möller–Trumbore in double), or by POV-Ray's own where `as_povray`
+/// (render.intersection: povray, the rules `whitted check` renders with; MeshAsPovray). That
+/// one differs from the exact test where a ray grazes a triangle (POV-Ray's single-precision
+/// plane moves the hit along the ray by up to 5e-3, past the shadow window) or passes within
+/// about 1e-9 of an edge (POV-Ray's float planes of two neighbours can leave a crack between
+/// them, or overlap): the instancing bench tori and the 1M-triangle anchor failed the strict
+/// rule at such pixels (docs/pov-model.md §3, "Mesh triangles"; docs/validation.md, "Grazing
+/// rays on the instancing bench tori"). It runs as POV-Ray runs it on the converter's mesh2: on
+/// the float offsets, with the ray moved by −origin in double (POV-Ray's `translate`); for a
+/// prototype's triangle (`instanced`) the ray is in the prototype's space with the world's t,
+/// and POV-Ray makes its direction unit length first. Embree's float test only proposes
 /// candidates: it is given triangles widened beyond its rounding (Impl::add_mesh), so every
 /// triangle the double ray meets is among them, and the widened parts are refused here.
 /// hit.normal is (v1 − v0) × (v2 − v0); u and v are set by the exact test only (the smooth
@@ -270,16 +274,19 @@ bool hit_triangle_in_double(const TriangleMesh& mesh, unsigned prim, const Ray& 
     const uint32_t* index = &mesh.indices[3 * size_t(prim)];
     const Vec3 v0 = vertex(mesh, index[0]), v1 = vertex(mesh, index[1]), v2 = vertex(mesh, index[2]);
     if (!as_povray) return intersect_triangle(v0, v1, v2, ray, ray.t_min, ray.t_max, hit, triangle_edge_margin);
+    const Vec3 p0 = offset_vertex(mesh, index[0]), p1 = offset_vertex(mesh, index[1]),
+               p2 = offset_vertex(mesh, index[2]);
+    const Vec3 origin = ray.origin - mesh.origin;
     double t = 0;
     bool inside = false;
     if (instanced) {
         const Vec3& d = ray.direction;
         const double len = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
         const double inverse = 1.0 / len;
-        if (!intersect_mesh2_triangle(v0, v1, v2, ray.origin, {d.x * inverse, d.y * inverse, d.z * inverse}, t, inside))
+        if (!intersect_mesh2_triangle(p0, p1, p2, origin, {d.x * inverse, d.y * inverse, d.z * inverse}, t, inside))
             return false;
         t /= len;
-    } else if (!intersect_mesh2_triangle(v0, v1, v2, ray.origin, ray.direction, t, inside)) {
+    } else if (!intersect_mesh2_triangle(p0, p1, p2, origin, ray.direction, t, inside)) {
         return false;
     }
     if (!inside || !(t > ray.t_min && t < ray.t_max)) return false;
@@ -557,14 +564,14 @@ Vec3 vertex_normal(const TriangleMesh& mesh, uint32_t index) {
     return {n[0], n[1], n[2]};
 }
 
-/// Whether a mesh is decided as POV-Ray decides it (decided_as_povray) and, if so, its vertex
+/// Whether a mesh is decided as POV-Ray decides it (hit_triangle_in_double) and, if so, its vertex
 /// normals as POV-Ray holds them: made unit length again as they are read, then stored as
 /// floats (POV-Ray's parse.cpp). Computed once here rather than at each hit (blended_normal).
 struct MeshAsPovray {
     bool decided = false;
     std::vector<float> normals;  ///< 3 per vertex; empty unless decided and the mesh has normals
 
-    explicit MeshAsPovray(const TriangleMesh& mesh) : decided(decided_as_povray(mesh)) {
+    MeshAsPovray(const TriangleMesh& mesh, Intersection rule) : decided(rule == Intersection::povray) {
         if (!decided || mesh.normals.empty()) return;
         normals.resize(mesh.normals.size());
         tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.normals.size() / 3, 8192),
@@ -721,10 +728,11 @@ struct Accelerator::Impl {
                 most_triangles = std::max(most_triangles, mesh.triangle_count());
         corner_indices = MappedArray<uint32_t>(3 * most_triangles, 0);
         for (size_t i = 0; i < 3 * most_triangles; ++i) corner_indices.data()[i] = uint32_t(i);
-        for (const TriangleMesh& mesh : scene.meshes) world_povray.emplace_back(mesh);
+        for (const TriangleMesh& mesh : scene.meshes) world_povray.emplace_back(mesh, scene.intersection);
         for (const Prototype& prototype : scene.prototypes) {
             prototype_povray.emplace_back();
-            for (const TriangleMesh& mesh : prototype.meshes) prototype_povray.back().emplace_back(mesh);
+            for (const TriangleMesh& mesh : prototype.meshes)
+                prototype_povray.back().emplace_back(mesh, scene.intersection);
         }
         for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
             const unsigned id = add_mesh(rtc_scene, scene.meshes[m], world_povray[m].decided, Vec3(0.0) - frame.offset,
@@ -1036,10 +1044,11 @@ struct Accelerator::Impl {
             const float* n = &povray.normals[3 * size_t(i)];
             return Vec3(n[0], n[1], n[2]);
         };
-        const Vec3 blended =
-            povray.decided ? mesh2_smooth_normal(vertex(mesh, index[0]), vertex(mesh, index[1]), vertex(mesh, index[2]),
-                                                 as_read(index[0]), as_read(index[1]), as_read(index[2]), point)
-                           : n0 * (1.0 - hit.u - hit.v) + n1 * hit.u + n2 * hit.v;
+        const Vec3 blended = povray.decided
+                                 ? mesh2_smooth_normal(offset_vertex(mesh, index[0]), offset_vertex(mesh, index[1]),
+                                                       offset_vertex(mesh, index[2]), as_read(index[0]),
+                                                       as_read(index[1]), as_read(index[2]), point - mesh.origin)
+                                 : n0 * (1.0 - hit.u - hit.v) + n1 * hit.u + n2 * hit.v;
         const double len = length(blended);
         if (!(len > 0)) return false;
         out = blended / len;
@@ -1111,21 +1120,26 @@ struct Accelerator::Impl {
             t_max = hit.t;
             found = true;
         }
-        // A plane takes a tie (within an ulp) with the shape found: the bottom of a box standing
-        // on the floor, met by a ray inside the box. POV-Ray, which the cross-check compares
-        // with, shows the plane there (docs/pov-model.md §3, "A plane keeps a tie"). Among the
-        // planes the first one keeps it.
-        double plane_t_max = found ? next_up(t_max) : t_max;
+        // A tie between a plane and the shape found (the bottom of a box standing on the floor,
+        // met by a ray inside the box), by the exact rule: the two distances within tie_window
+        // of each other (a tie in real numbers that rounding split) and the first object in the
+        // file keeps it. Under POV-Ray's rules the plane keeps a tie within an ulp, as POV-Ray
+        // shows it there (docs/pov-model.md §3, "A plane keeps a tie"). Among the planes the
+        // first one keeps it either way.
+        const bool povray = scene.intersection == Intersection::povray;
+        bool plane_found = false;
         for (const Plane& plane : scene.planes) {
+            const double window = found && !povray ? tie_window(ray, t_max) : 0.0;
+            const double limit = found && povray && !plane_found ? next_up(t_max) : t_max + window;
             ShapeHit plane_hit;
-            if (intersect_plane(plane, ray, ray.t_min, plane_t_max, plane_hit)) {
-                t_max = plane_t_max = plane_hit.t;
-                out.t = plane_hit.t;
-                out.normal = out.geometric_normal = plane.normal;
-                out.material = plane.material;
-                out.object = plane.object;
-                found = true;
-            }
+            if (!intersect_plane(plane, ray, ray.t_min, limit, plane_hit)) continue;
+            if (!povray && found && !(plane_hit.t < t_max - window) && plane.object > out.object) continue;
+            t_max = plane_hit.t;
+            out.t = plane_hit.t;
+            out.normal = out.geometric_normal = plane.normal;
+            out.material = plane.material;
+            out.object = plane.object;
+            found = plane_found = true;
         }
         if (found) out.point = ray.at(out.t);
         return found;

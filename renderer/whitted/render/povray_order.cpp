@@ -126,11 +126,12 @@ Bounds box_bounds(const Box& box) {
 /// over its triangles), written about the mesh's centre, then moved there by `translate`,
 /// which recomputes the box as any transform does.
 void mesh_bounds(const TriangleMesh& mesh, std::vector<Bounds>& out) {
-    const auto vertex = [&](size_t i) {
+    // The converter writes the mesh2 about the point Whitted stores it about: its float offsets.
+    const auto offset = [&](size_t i) {
         const float* p = &mesh.positions[4 * i];
         return Vec3(p[0], p[1], p[2]);
     };
-    const Vec3 centre = povray_mesh_centre(mesh.vertex_count(), vertex);
+    const Vec3& centre = mesh.origin;
     std::vector<uint32_t> materials(mesh.triangle_materials);
     std::sort(materials.begin(), materials.end());
     materials.erase(std::unique(materials.begin(), materials.end()), materials.end());
@@ -142,8 +143,7 @@ void mesh_bounds(const TriangleMesh& mesh, std::vector<Bounds>& out) {
                 ? 0
                 : size_t(std::lower_bound(materials.begin(), materials.end(), mesh.triangle_materials[t]) -
                          materials.begin());
-        for (int k = 0; k < 3; ++k)
-            pieces[piece].add(vertex(mesh.indices[3 * t + k]) - centre);  // exact: povray_mesh_centre
+        for (int k = 0; k < 3; ++k) pieces[piece].add(offset(mesh.indices[3 * t + k]));
     }
     for (const Around& piece : pieces) {
         Bounds b = piece.bounds();
@@ -279,22 +279,6 @@ void povray_box_corners(const Transform& to_world, const Vec3& min, const Vec3& 
     const Vec3 pad(std::ldexp(scale, -20) + 1e-30);  // 2^-20: 8 to 16 floats' spacing at `scale`
     lo -= pad;
     hi += pad;
-}
-
-Vec3 povray_mesh_centre(size_t count, const std::function<Vec3(size_t)>& vertex) {
-    constexpr double far_mesh_coordinate = 16;  // below it, float plane distances are within 1e-6
-    double centre[3] = {0, 0, 0};
-    if (count == 0) return Vec3(0.0);
-    for (int axis = 0; axis < 3; ++axis) {
-        double lo = INFINITY, hi = -INFINITY;
-        for (size_t i = 0; i < count; ++i) lo = std::min(lo, vertex(i)[axis]), hi = std::max(hi, vertex(i)[axis]);
-        if (std::max(std::fabs(lo), std::fabs(hi)) < far_mesh_coordinate) continue;
-        const double c = float(0.5 * (lo + hi));
-        bool exact = true;
-        for (size_t i = 0; i < count && exact; ++i) exact = double(float(vertex(i)[axis] - c)) == vertex(i)[axis] - c;
-        if (exact) centre[axis] = c;
-    }
-    return {centre[0], centre[1], centre[2]};
 }
 
 PovrayTestOrder::PovrayTestOrder(const Scene& scene) : m_scene(scene) {
@@ -543,7 +527,7 @@ bool PovrayTestOrder::test(const Ray& ray, uint32_t shape, ShapeHit& hit) const 
     const size_t spheres = m_scene.spheres.size();
     if (shape < spheres) return intersect_sphere(m_scene.spheres[shape], ray, ray.t_min, ray.t_max, hit);
     if (shape < spheres + m_scene.boxes.size())
-        return intersect_box(m_scene.boxes[shape - spheres], ray, ray.t_min, ray.t_max, hit);
+        return intersect_box(m_scene.boxes[shape - spheres], ray, ray.t_min, ray.t_max, hit, Intersection::povray);
     return false;  // a plane (finish_hit weighs planes) or a mesh: not a candidate here
 }
 

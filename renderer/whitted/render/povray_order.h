@@ -99,10 +99,4 @@ private:
 /// bounds pushed out by 8 to 16 floats' spacing.
 void povray_box_corners(const Transform& to_world, const Vec3& min, const Vec3& max, Vec3& lo, Vec3& hi);
 
-/// The point `whitted convert` writes a mesh2's vertices about, moving it there with
-/// `translate` (pov_writer.cpp): per axis, a float near the middle of the `count` vertices when
-/// they reach 16 or more from the origin on that axis and every vertex minus it is exactly a
-/// float; otherwise 0.
-Vec3 povray_mesh_centre(size_t count, const std::function<Vec3(size_t)>& vertex);
-
 }  // namespace whitted

@@ -93,14 +93,15 @@ struct Watching {
 
 Color LectureShading::shadow_filter(Ray shadow_ray) const {
     // POV-Ray's walk: each surface met multiplies the light by its kt, and the search goes on
-    // from shadow_epsilon past it; an opaque one ends it.
+    // from the shadow window's width past it (RaySpans::shadow, at that surface); an opaque one
+    // ends it.
     Color filter(1.0);
     SurfaceHit hit;
     while (shadow_ray.t_max > shadow_ray.t_min && m_accelerator.intersect(shadow_ray, hit)) {
         const Color& kt = m_scene.materials[hit.material].kt;
         if (is_zero(kt)) return Color(0.0);
         filter = filter * kt;
-        shadow_ray.t_min = hit.t + ray_limits::shadow_epsilon;
+        shadow_ray.t_min = hit.t + m_spans.shadow(hit.point);
     }
     return filter;
 }
@@ -185,7 +186,9 @@ void LectureShading::direct_lighting_with(const SurfaceHit* hits, const Ray* ray
                 to_light = offset / light_distance;
             } else {
                 to_light = light.toward_light;
-                light_distance = ray_limits::directional_light_distance - dot(point, to_light);
+                // The course's span is a fraction of the light's distance: it needs a finite one.
+                light_distance = course ? ray_limits::directional_light_distance - dot(point, to_light)
+                                        : m_spans.directional_light_distance(point, to_light);
             }
             n_dot_l[i] = dot(normal[i], to_light);
             if constexpr (Observer::watching) shadow_rays[i].direction = to_light;  // l, also where unlit
@@ -202,8 +205,9 @@ void LectureShading::direct_lighting_with(const SurfaceHit* hits, const Ray* ray
             // The gate on both terms: a light behind the surface adds nothing.
             if (!(n_dot_l[i] > ray_limits::cosine_epsilon)) continue;
             lit[i] = true;
-            // Shadow ray from x itself (no offset; the epsilons do the work) to just short of the light.
-            shadow_rays[i] = {point, to_light, ray_limits::shadow_epsilon, light_distance - ray_limits::shadow_epsilon};
+            // Shadow ray from x itself (no offset; the window does the work) to just short of the light.
+            const double window = m_spans.shadow(point);
+            shadow_rays[i] = {point, to_light, window, light_distance - window};
             query[i] = shadow_rays[i].t_max > shadow_rays[i].t_min;  // else the light is on the surface: unblocked
             counts.shadow += query[i];
         }
@@ -335,7 +339,7 @@ void LectureShading::trace_paths(const Ray* first_rays, const Color* first_weigh
                 Vec3 direction;
                 if (refract(rays[i], hits[i], normal[i], refracted_interiors, direction)) {
                     refracted = true;
-                    refracted_ray = {hits[i].point, direction, ray_limits::surface_t_min, ray_limits::max_distance};
+                    refracted_ray = {hits[i].point, direction, m_spans.leaving(hits[i].point), m_spans.t_max()};
                 } else {
                     mirror_weight = Color(1.0);
                 }
@@ -349,7 +353,7 @@ void LectureShading::trace_paths(const Ray* first_rays, const Color* first_weigh
             if (mirrored) {
                 // Mirror: r = 2(n·v)n − v, from the hit point itself (no offset; t_min does the work).
                 const Vec3 mirror_direction = normalize(normal[i] * (2.0 * dot(normal[i], to_eye)) - to_eye);
-                rays[i] = {hits[i].point, mirror_direction, ray_limits::surface_t_min, ray_limits::max_distance};
+                rays[i] = {hits[i].point, mirror_direction, m_spans.leaving(hits[i].point), m_spans.t_max()};
                 weight[i] = next_weight;
                 observer.mirror(i, level, rays[i], weight[i]);
                 ++counts.reflected;

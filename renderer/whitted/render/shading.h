@@ -3,6 +3,7 @@
 
 #include "whitted/core/ray.h"
 #include "whitted/render/accelerator.h"
+#include "whitted/render/ray_spans.h"
 #include "whitted/scene/scene.h"
 
 #include <cstdint>
@@ -82,7 +83,8 @@ using Interiors = std::vector<std::pair<uint32_t, double>>;
 /// mirror rays. Each refracted ray starts a path of its own, traced at once, depth first.
 class LectureShading {
 public:
-    LectureShading(const Scene& scene, const Accelerator& accelerator) : m_scene(scene), m_accelerator(accelerator) {
+    LectureShading(const Scene& scene, const Accelerator& accelerator)
+        : m_scene(scene), m_accelerator(accelerator), m_spans(scene) {
         for (const Material& material : scene.materials) m_transmits |= !is_zero(material.kt);
     }
 
@@ -136,6 +138,7 @@ private:
 
     const Scene& m_scene;
     const Accelerator& m_accelerator;
+    RaySpans m_spans;          ///< where rays start and end (render.intersection)
     bool m_transmits = false;  ///< some material has kt: shadow rays walk, refracted rays branch
 };
 

@@ -67,6 +67,14 @@ enum class Highlight { blinn, phong };
 /// `course` the Cornell CS4620 ray tracer's (normals as given, its shadow-ray span, no n·l gate
 /// on the highlight).
 enum class Convention { pov, course };
+/// How a ray's nearest surface is decided (docs/scene-format.md §2.3, `render.intersection`).
+/// `exact`, the default: in double from the scene's own numbers, watertight, and a tie at exactly
+/// one distance goes to the object first in the file, whatever order the BVH meets them in.
+/// `povray`: POV-Ray 3.7's own decisions where they differ from the exact answer (its float
+/// mesh2 triangle test and smooth normals, its box edge and depth constants, its test order for
+/// tied spheres and boxes, a plane keeping a tie within an ulp), which `whitted check` selects so
+/// that the two renderers agree pixel by pixel (renderer/whitted/compat/povray.h).
+enum class Intersection { exact, povray };
 
 struct CameraDescription {
     SourceLocation where;
@@ -198,6 +206,7 @@ struct SceneDescription {
     std::vector<Located<std::string>> layers;
     Located<Convention> convention{Convention::pov};
     Located<double> min_weight{0.0};  ///< a mirror ray whose path weight is below this is not traced
+    Located<Intersection> intersection{Intersection::exact};
     Located<Color> ambient{Color{1.0}};
     std::vector<LightDescription> lights;
     std::vector<MaterialDescription> materials;  ///< in file order

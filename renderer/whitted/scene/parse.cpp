@@ -613,6 +613,9 @@ void parse_render_conventions(const MapReader& render, SceneDescription& scene) 
         return parse_choice<Convention>(c, n, w, {{"pov", Convention::pov}, {"course", Convention::course}});
     });
     render.number(scene.min_weight, "min_weight");
+    render.read(scene.intersection, "intersection", [](const ParseContext& c, const Node& n, const What& w) {
+        return parse_choice<Intersection>(c, n, w, {{"exact", Intersection::exact}, {"povray", Intersection::povray}});
+    });
 }
 
 SceneDescription parse_document(ParseContext& ctx, const Node& root) {
@@ -630,12 +633,14 @@ SceneDescription parse_document(ParseContext& ctx, const Node& root) {
     scene.camera = parse_camera(ctx, map.require("camera"));
     scene.image = parse_image(ctx, map.require("image"));
     if (map.has("render")) {
-        MapReader render(ctx, map.get("render"), "render", {"max_depth", "layers", "convention", "min_weight"});
+        MapReader render(ctx, map.get("render"), "render",
+                         {"max_depth", "layers", "convention", "min_weight", "intersection"});
         render.integer(scene.max_depth, "max_depth");
         if (render.has("layers")) scene.layers = parse_render_layers(ctx, render.get("layers"));
         parse_render_conventions(render, scene);
     } else {
-        scene.max_depth.where = scene.convention.where = scene.min_weight.where = map.where();
+        scene.max_depth.where = scene.convention.where = scene.min_weight.where = scene.intersection.where =
+            map.where();
     }
     map.color(scene.ambient, "ambient");
     if (map.has("lights")) {

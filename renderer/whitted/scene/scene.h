@@ -93,10 +93,27 @@ struct Plane {
     uint32_t object = 0;  ///< Scene::objects index + 1
 };
 
-/// Triangles in world space, stored as Embree wants them (float, xyz + padding). Positions
-/// are float as Embree needs; hits are recomputed in double from these same floats.
+/// The point a mesh whose vertices (world space, double) span [lo, hi] is stored about
+/// (TriangleMesh::origin): the centre of its bounds when that lies further from the origin than
+/// the mesh's half extent, else the origin itself (whose floats then hold each coordinate to
+/// 2^-24 of the mesh's own size already). So a mesh keeps float's precision relative to its own
+/// size wherever it stands and at any scale. `whitted convert` writes each mesh2 about the same
+/// point, so that POV-Ray reads the same float triangles.
+inline Vec3 mesh_origin(const Vec3& lo, const Vec3& hi) {
+    if (!(lo.x <= hi.x)) return Vec3(0.0);  // no vertices
+    const Vec3 centre = (lo + hi) * 0.5, half = (hi - lo) * 0.5;
+    const double far = std::max({std::fabs(centre.x), std::fabs(centre.y), std::fabs(centre.z)});
+    return far > std::max({half.x, half.y, half.z}) ? centre : Vec3(0.0);
+}
+
+/// Triangles in world space: each vertex is `origin` (double) plus a float offset, stored as
+/// Embree wants them (xyz + padding). The origin is the centre of the mesh's bounds, or the
+/// world's origin for a mesh around it, so that the floats keep precision relative to the mesh's
+/// own size wherever it stands (mesh_origin); hits are computed in double from these vertices
+/// (vertex()).
 struct TriangleMesh {
-    std::vector<float> positions;              ///< 4 floats per vertex (x, y, z, unused)
+    Vec3 origin;
+    std::vector<float> positions;              ///< 4 floats per vertex (x, y, z, unused): offsets from `origin`
     std::vector<uint32_t> indices;             ///< 3 per triangle
     std::vector<float> normals;                ///< empty, or 3 floats per vertex: smooth shading
     std::vector<uint32_t> triangle_materials;  ///< empty when every triangle uses `material`
@@ -104,6 +121,11 @@ struct TriangleMesh {
     uint32_t object = 0;  ///< Scene::objects index + 1 (one object per mesh or triangle)
     size_t triangle_count() const { return indices.size() / 3; }
     size_t vertex_count() const { return positions.size() / 4; }
+    /// Vertex `index` in world space (a prototype's mesh: in the prototype's space).
+    Vec3 vertex(size_t index) const {
+        const float* p = &positions[4 * index];
+        return origin + Vec3(p[0], p[1], p[2]);
+    }
 };
 
 /// A prototype (docs/scene-format.md §3.8): triangles in a space of their own, stored once and
@@ -140,6 +162,7 @@ struct Scene {
     int max_depth = 5;
     Convention convention = Convention::pov;
     double min_weight = 0;  ///< mirror rays whose path weight (largest channel) is below it are not traced
+    Intersection intersection = Intersection::exact;  ///< render.intersection (description.h)
     Color background;
     Color ambient;  ///< I_a
     Camera camera;

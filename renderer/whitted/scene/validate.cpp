@@ -180,7 +180,7 @@ private:
             prototype.lo = Vec3(inf), prototype.hi = Vec3(-inf);
             for (const TriangleMesh& mesh : prototype.meshes)
                 for (size_t i = 0; i < mesh.vertex_count(); ++i) {
-                    const Vec3 p{mesh.positions[4 * i], mesh.positions[4 * i + 1], mesh.positions[4 * i + 2]};
+                    const Vec3 p = mesh.vertex(i);
                     prototype.lo = min(prototype.lo, p), prototype.hi = max(prototype.hi, p);
                 }
             m_scene.prototypes.push_back(std::move(prototype));
@@ -283,10 +283,11 @@ private:
             case ObjectType::triangle: {
                 TriangleMesh mesh;
                 mesh.material = resolve_material(object);
-                for (const Vec3& v : object.vertices) push_position(mesh, to_world.apply_point(v));
+                set_positions(
+                    mesh, 3, [&](size_t i) { return to_world.apply_point(object.vertices[i]); }, object.vertices_where);
                 mesh.indices = {0, 1, 2};
                 mesh.object = add_id(object);
-                add_mesh(std::move(mesh), object.vertices_where);
+                add_mesh(std::move(mesh));
                 break;
             }
             case ObjectType::mesh:
@@ -395,7 +396,8 @@ private:
                                            std::to_string(n) + " vertices; give one per vertex");
         TriangleMesh mesh;
         mesh.material = resolve_material(object);
-        for (const Vec3& v : object.vertices) push_position(mesh, to_world.apply_point(v));
+        set_positions(
+            mesh, n, [&](size_t i) { return to_world.apply_point(object.vertices[i]); }, object.vertices_where);
         for (size_t t = 0; t < object.triangles.size(); ++t)
             for (const int64_t index : object.triangles[t]) {
                 if (index < 0 || index >= static_cast<int64_t>(n))
@@ -410,7 +412,7 @@ private:
             push_normal(mesh, to_world.apply_normal(object.normals[i]));
         }
         mesh.object = add_id(object);
-        add_mesh(std::move(mesh), object.vertices_where);
+        add_mesh(std::move(mesh));
     }
 
     void add_mesh_file(const ObjectDescription& object, const Transform& to_world) {
@@ -454,10 +456,13 @@ private:
             }
         }
         const size_t n = data.positions.size() / 3;
-        mesh.positions.reserve(4 * n);
-        for (size_t i = 0; i < n; ++i)
-            push_position(mesh, to_world.apply_point(
-                                    {data.positions[3 * i], data.positions[3 * i + 1], data.positions[3 * i + 2]}));
+        set_positions(
+            mesh, n,
+            [&](size_t i) {
+                return to_world.apply_point(
+                    {data.positions[3 * i], data.positions[3 * i + 1], data.positions[3 * i + 2]});
+            },
+            object.file.where);
         if (!data.normals.empty()) {
             mesh.normals.reserve(3 * n);
             for (size_t i = 0; i < n; ++i)
@@ -466,16 +471,10 @@ private:
         }
         mesh.indices = std::move(data.indices);
         mesh.object = add_id(object);
-        add_mesh(std::move(mesh), object.file.where);
+        add_mesh(std::move(mesh));
     }
 
-    /// Triangles are stored as float for Embree, whose results are undefined for non-finite
-    /// vertices: a coordinate beyond float range (given, or after the transform) is refused.
-    void add_mesh(TriangleMesh mesh, const SourceLocation& where) {
-        for (size_t i = 0; i < mesh.positions.size(); ++i)
-            if (!std::isfinite(mesh.positions[i]))
-                fail(where, "vertex " + std::to_string(i / 4) +
-                                " is beyond float range (about 3.4e38) once transformed to world space");
+    void add_mesh(TriangleMesh mesh) {
         (m_prototype ? m_prototype->meshes : m_scene.meshes).push_back(std::move(mesh));
     }
 
@@ -487,8 +486,31 @@ private:
         return static_cast<uint32_t>(m_scene.objects.size());
     }
 
-    static void push_position(TriangleMesh& mesh, const Vec3& p) {
-        mesh.positions.insert(mesh.positions.end(), {float(p.x), float(p.y), float(p.z), 0.0f});
+    /// The mesh's `count` vertices, given in world space (double) by `world_point`: stored as
+    /// float offsets from mesh_origin (scene.h). So a mesh keeps float's precision relative to its
+    /// own size wherever it stands: moved or scaled with the whole scene, its triangles are the
+    /// same to a float's rounding of its own size (docs/validation.md, "Far from the origin"), as
+    /// a sphere's or a box's are. A world coordinate beyond float range is refused, naming the
+    /// vertex: Embree's BVH needs finite float bounds.
+    template <class WorldPoint>
+    void set_positions(TriangleMesh& mesh, size_t count, const WorldPoint& world_point, const SourceLocation& where) {
+        constexpr double inf = std::numeric_limits<double>::infinity();
+        constexpr double float_max = std::numeric_limits<float>::max();
+        Vec3 lo(inf), hi(-inf);
+        for (size_t i = 0; i < count; ++i) {
+            const Vec3 p = world_point(i);
+            if (!(std::fabs(p.x) <= float_max && std::fabs(p.y) <= float_max && std::fabs(p.z) <= float_max))
+                fail(where, "vertex " + std::to_string(i) +
+                                " is beyond float range (about 3.4e38) once transformed to world space");
+            lo = min(lo, p), hi = max(hi, p);
+        }
+        mesh.origin = mesh_origin(lo, hi);
+        mesh.positions.clear();
+        mesh.positions.reserve(4 * count);
+        for (size_t i = 0; i < count; ++i) {
+            const Vec3 p = world_point(i) - mesh.origin;
+            mesh.positions.insert(mesh.positions.end(), {float(p.x), float(p.y), float(p.z), 0.0f});
+        }
     }
     static void push_normal(TriangleMesh& mesh, const Vec3& n) {
         // A zero normal from the file (rare) stays zero; shading then falls back to the face normal.
@@ -702,6 +724,7 @@ void validate_settings(const SceneDescription& d, Scene& scene) {
         fail(d.min_weight.where, "render.min_weight must be between 0 and 1");
     scene.convention = d.convention.value;
     scene.min_weight = d.min_weight.value;
+    scene.intersection = d.intersection.value;
     scene.width = static_cast<int>(image.width.value);
     scene.height = static_cast<int>(image.height.value);
     scene.samples = static_cast<int>(image.samples.value);
