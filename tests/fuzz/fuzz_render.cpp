@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: MIT
+// Fuzzes what runs, not only what parses: any bytes as a scene file (NFF when they begin as an
+// NFF file does, the course's XML when they begin with `<`, YAML otherwise), written to a file
+// and read as `whitted render` reads it (load_scene_file), then rendered through
+// Embree at a few pixels and a shallow depth. The only acceptable refusal is InputError (exit 2
+// in `whitted`), whether the reader or the accelerator raises it; a signal, an Embree assertion,
+// a sanitizer report or any other exception is a finding. Embree's instruction set is
+// $WHITTED_EMBREE_ISA, as for `whitted render` (sse2 changes the packet width and the BVH's node
+// width), the machine's widest when unset; scripts/fuzz and the replay tests run both.
+
+#include "fuzz_support.h"
+#include "whitted/render/accelerator.h"
+#include "whitted/render/renderer.h"
+#include "whitted/scene/description.h"
+#include "whitted/scene/scene.h"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace {
+
+/// An NFF file's first entity, after any `#` comment lines, is a one-letter keyword on its own
+/// word (`v`, `b`, `l`, `f`, `c`, `s`, `p`, `pp`); the seeds from tests/nff begin that way. (A YAML
+/// scene may begin with `#` comments too.)
+bool looks_like_nff(const std::string& text) {
+    size_t line = 0;
+    while (line < text.size() && (text[line] == '#' || text[line] == '\n' || text[line] == '\r')) {
+        const size_t end = text.find('\n', line);
+        if (end == std::string::npos) return false;
+        line = end + 1;
+    }
+    const size_t end = text.find_first_of(" \t\r\n", line);
+    const std::string word = text.substr(line, end == std::string::npos ? std::string::npos : end - line);
+    return word == "v" || word == "b" || word == "l" || word == "f" || word == "c" || word == "s" || word == "p" ||
+           word == "pp";
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    using namespace whitted;
+    const std::string text(reinterpret_cast<const char*>(data), size);
+    // In the scratch directory, so relative mesh paths find the fixtures (or nothing).
+    const char* const name = looks_like_nff(text) ? "scene.nff" : text.rfind('<', 0) == 0 ? "scene.xml" : "scene.yaml";
+    const std::string path = (fuzz::scratch_directory() / name).string();
+    fuzz::write_file(path, text);
+    try {
+        Scene scene = load_scene_file(path);
+        // A few pixels and a shallow tree: what is fuzzed is every shape's intersection, the
+        // BVH over the scene's bounds, shadows, mirrors and refraction, not the resolution.
+        scene.width = std::min(scene.width, 3);
+        scene.height = std::min(scene.height, 3);
+        scene.samples = std::min(scene.samples, 2);
+        scene.max_depth = std::min(scene.max_depth, 3);
+        const Accelerator accelerator(scene, 1);
+        RenderOptions options;
+        options.threads = 1;
+        const RenderResult result = render(scene, accelerator, options);
+        if (result.image.width != scene.width || result.image.height != scene.height) __builtin_trap();
+        // Every radiance the lecture's model gives is a number and not negative: its terms are
+        // products and sums of non-negative numbers, clamped by max(0, ·). (Not always finite: a
+        // colour of 1e258 overflows the float pixel, which validation does not bound yet.)
+        for (const float value : result.image.rgb)
+            if (!(value >= 0)) __builtin_trap();
+    } catch (const InputError& e) {
+        if (std::string(e.what()).empty()) __builtin_trap();
+    }
+    return 0;
+}
