@@ -420,10 +420,6 @@ TEST(Accelerator, EveryTriangleTheDoubleTestAcceptsIsFound) {
         const Accelerator accelerator(scene, 1);
         const bool as_povray = rule == Intersection::povray;
         const TriangleMesh& mesh = scene.meshes[0];
-        const auto stored = [&](int i) {  // the float offset from mesh.origin
-            const float* p = &mesh.positions[4 * size_t(i)];
-            return Vec3(p[0], p[1], p[2]);
-        };
         int hits = 0;
         for (Ray ray : rays_at_edges(vertices, faces)) {
             double nearest = ray.t_max;
@@ -435,8 +431,9 @@ TEST(Accelerator, EveryTriangleTheDoubleTestAcceptsIsFound) {
                 bool inside = false;
                 ShapeHit exact;
                 if (as_povray) {
-                    if (intersect_mesh2_triangle(stored(f[0]), stored(f[1]), stored(f[2]), ray.origin - mesh.origin,
-                                                 ray.direction, depth, inside) &&
+                    if (intersect_mesh2_triangle(mesh.offset(size_t(f[0])), mesh.offset(size_t(f[1])),
+                                                 mesh.offset(size_t(f[2])), ray.origin - mesh.origin, ray.direction,
+                                                 depth, inside) &&
                         inside && depth > ray.t_min && depth < ray.t_max)
                         accepted.push_back(depth);
                 } else if (intersect_triangle(a, b, c, ray, ray.t_min, ray.t_max, exact, 1e-10)) {

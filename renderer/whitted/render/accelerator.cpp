@@ -215,10 +215,6 @@ void analytic_occluded(const RTCOccludedFunctionNArguments* args) {
     }
 }
 
-Vec3 vertex(const TriangleMesh& mesh, uint32_t index) {
-    return mesh.vertex(index);
-}
-
 /// How far apart two surfaces a ray meets at `t` may be found and still be one tie by the exact
 /// rule (render.intersection: exact): 64 ulps of the largest coordinate or distance the two
 /// distances were computed from. A face lying in a plane is met by both at one t in real
@@ -245,13 +241,6 @@ struct TriangleGeometry {
 /// a ray along an edge two triangles share meets at least one of them.
 constexpr double triangle_edge_margin = 1e-10;
 
-/// Vertex `index` of `mesh` as its float offset from TriangleMesh::origin: the vertex as the
-/// mesh2 `whitted convert` writes holds it, about that origin (moved there by `translate`).
-Vec3 offset_vertex(const TriangleMesh& mesh, uint32_t index) {
-    const float* p = &mesh.positions[4 * size_t(index)];
-    return {p[0], p[1], p[2]};
-}
-
 /// The decision on a triangle candidate, made in double from the scene's own float vertices
 /// and the double ray: the ray passes inside the triangle and meets it within (t_min, t_max),
 /// by the exact test (Möller–Trumbore in double), or by POV-Ray's own where `as_povray`
@@ -272,10 +261,9 @@ Vec3 offset_vertex(const TriangleMesh& mesh, uint32_t index) {
 bool hit_triangle_in_double(const TriangleMesh& mesh, unsigned prim, const Ray& ray, bool as_povray, bool instanced,
                             ShapeHit& hit) {
     const uint32_t* index = &mesh.indices[3 * size_t(prim)];
-    const Vec3 v0 = vertex(mesh, index[0]), v1 = vertex(mesh, index[1]), v2 = vertex(mesh, index[2]);
+    const Vec3 v0 = mesh.vertex(index[0]), v1 = mesh.vertex(index[1]), v2 = mesh.vertex(index[2]);
     if (!as_povray) return intersect_triangle(v0, v1, v2, ray, ray.t_min, ray.t_max, hit, triangle_edge_margin);
-    const Vec3 p0 = offset_vertex(mesh, index[0]), p1 = offset_vertex(mesh, index[1]),
-               p2 = offset_vertex(mesh, index[2]);
+    const Vec3 p0 = mesh.offset(index[0]), p1 = mesh.offset(index[1]), p2 = mesh.offset(index[2]);
     const Vec3 origin = ray.origin - mesh.origin;
     double t = 0;
     bool inside = false;
@@ -371,7 +359,7 @@ void widen_triangles(const TriangleMesh& mesh, const Vec3& shift, double margin,
             for (size_t t = range.begin(); t != range.end(); ++t) {
                 const uint32_t* index = &mesh.indices[3 * t];
                 Vec3 p[3];
-                for (int k = 0; k < 3; ++k) p[k] = vertex(mesh, index[k]) + shift;
+                for (int k = 0; k < 3; ++k) p[k] = mesh.vertex(index[k]) + shift;
                 const Vec3 ab = p[1] - p[0], ac = p[2] - p[0], bc = p[2] - p[1];
                 // Each corner is weighed by the length of the side facing it.
                 const double a = std::sqrt(dot(bc, bc)), b = std::sqrt(dot(ac, ac)), c = std::sqrt(dot(ab, ab));
@@ -789,7 +777,7 @@ struct Accelerator::Impl {
         for (const TriangleMesh& mesh : scene.meshes) {
             double reached = 0;
             for (uint32_t i = 0; i < mesh.vertex_count(); ++i) {
-                const Vec3 v = vertex(mesh, i);
+                const Vec3 v = mesh.vertex(i);
                 reached = std::max({reached, std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)});
             }
             check(mesh.object, reached);
@@ -838,8 +826,8 @@ struct Accelerator::Impl {
         Vec3 lo(inf), hi(-inf);
         for (const TriangleMesh& mesh : scene.meshes)
             for (uint32_t i = 0; i < mesh.vertex_count(); ++i) {
-                lo = min(lo, vertex(mesh, i));
-                hi = max(hi, vertex(mesh, i));
+                lo = min(lo, mesh.vertex(i));
+                hi = max(hi, mesh.vertex(i));
             }
         for (const Sphere& sphere : scene.spheres) {
             Vec3 a, b;
@@ -1044,11 +1032,11 @@ struct Accelerator::Impl {
             const float* n = &povray.normals[3 * size_t(i)];
             return Vec3(n[0], n[1], n[2]);
         };
-        const Vec3 blended = povray.decided
-                                 ? mesh2_smooth_normal(offset_vertex(mesh, index[0]), offset_vertex(mesh, index[1]),
-                                                       offset_vertex(mesh, index[2]), as_read(index[0]),
-                                                       as_read(index[1]), as_read(index[2]), point - mesh.origin)
-                                 : n0 * (1.0 - hit.u - hit.v) + n1 * hit.u + n2 * hit.v;
+        const Vec3 blended =
+            povray.decided
+                ? mesh2_smooth_normal(mesh.offset(index[0]), mesh.offset(index[1]), mesh.offset(index[2]),
+                                      as_read(index[0]), as_read(index[1]), as_read(index[2]), point - mesh.origin)
+                : n0 * (1.0 - hit.u - hit.v) + n1 * hit.u + n2 * hit.v;
         const double len = length(blended);
         if (!(len > 0)) return false;
         out = blended / len;

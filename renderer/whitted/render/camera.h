@@ -12,6 +12,8 @@ namespace whitted {
 /// t_min < t < t_max (RaySpans::camera_t_min, RaySpans::t_max).
 Ray camera_ray(const Camera& camera, double x0, double y0, double t_min = ray_limits::surface_t_min,
                double t_max = ray_limits::max_distance);
+/// The same for the scene's camera, with the range its render.intersection gives (RaySpans).
+Ray camera_ray(const Scene& scene, double x0, double y0);
 
 /// Screen coordinates of sample (a, b) of an n×n grid inside pixel (i, j) of a W×H image.
 inline void sample_position(int i, int j, int a, int b, int n, int width, int height, double& x0, double& y0) {

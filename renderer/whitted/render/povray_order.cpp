@@ -127,10 +127,6 @@ Bounds box_bounds(const Box& box) {
 /// which recomputes the box as any transform does.
 void mesh_bounds(const TriangleMesh& mesh, std::vector<Bounds>& out) {
     // The converter writes the mesh2 about the point Whitted stores it about: its float offsets.
-    const auto offset = [&](size_t i) {
-        const float* p = &mesh.positions[4 * i];
-        return Vec3(p[0], p[1], p[2]);
-    };
     const Vec3& centre = mesh.origin;
     std::vector<uint32_t> materials(mesh.triangle_materials);
     std::sort(materials.begin(), materials.end());
@@ -143,7 +139,7 @@ void mesh_bounds(const TriangleMesh& mesh, std::vector<Bounds>& out) {
                 ? 0
                 : size_t(std::lower_bound(materials.begin(), materials.end(), mesh.triangle_materials[t]) -
                          materials.begin());
-        for (int k = 0; k < 3; ++k) pieces[piece].add(offset(mesh.indices[3 * t + k]));
+        for (int k = 0; k < 3; ++k) pieces[piece].add(mesh.offset(mesh.indices[3 * t + k]));
     }
     for (const Around& piece : pieces) {
         Bounds b = piece.bounds();

@@ -1,11 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "whitted/render/renderer.h"
 
-#include "whitted/render/ray_spans.h"
-
 #include "whitted/core/packet_array.h"
 #include "whitted/render/camera.h"
-#include "whitted/render/ray_spans.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
@@ -29,7 +26,7 @@ Color render_pixel(const Scene& scene, const LectureShading& shading, int i, int
         for (int a = 0; a < n; ++a) {
             double x0, y0;
             sample_position(i, j, a, b, n, scene.width, scene.height, x0, y0);
-            rays[count++] = camera_ray(scene.camera, x0, y0, RaySpans(scene).camera_t_min(), RaySpans(scene).t_max());
+            rays[count++] = camera_ray(scene, x0, y0);
             if (count == Accelerator::packet_size || (a == n - 1 && b == n - 1)) {
                 shading.trace_packet(rays.data(), count, 0, radiance.data(), counts);
                 for (int k = 0; k < count; ++k) sum += radiance[k];
@@ -59,8 +56,7 @@ void for_each_single_sample_packet(const Scene& scene, int x_begin, int x_end, i
                 for (int x = bx; x < std::min(bx + side, x_end); ++x) {
                     double x0, y0;
                     sample_position(x, y, 0, 0, 1, scene.width, scene.height, x0, y0);
-                    rays[count] =
-                        camera_ray(scene.camera, x0, y0, RaySpans(scene).camera_t_min(), RaySpans(scene).t_max());
+                    rays[count] = camera_ray(scene, x0, y0);
                     pixel_x[count] = x, pixel_y[count] = y;
                     ++count;
                 }
@@ -120,7 +116,7 @@ void render_pixel_layers(const Scene& scene, const LectureShading& shading, Laye
         for (int a = 0; a < n; ++a) {
             double x0, y0;
             sample_position(i, j, a, b, n, scene.width, scene.height, x0, y0);
-            rays[count++] = camera_ray(scene.camera, x0, y0, RaySpans(scene).camera_t_min(), RaySpans(scene).t_max());
+            rays[count++] = camera_ray(scene, x0, y0);
             if (count == Accelerator::packet_size || (a == n - 1 && b == n - 1)) {
                 recorder.reset();
                 shading.trace_packet(rays.data(), count, 0, radiance.data(), counts, recorder);
@@ -165,8 +161,7 @@ std::vector<CameraPacket> camera_packets(const Scene& scene, int i, int j) {
             for (int x = bx; x < std::min(bx + side, scene.width); ++x) {
                 double x0, y0;
                 sample_position(x, y, 0, 0, 1, scene.width, scene.height, x0, y0);
-                packet.rays.push_back(
-                    camera_ray(scene.camera, x0, y0, RaySpans(scene).camera_t_min(), RaySpans(scene).t_max()));
+                packet.rays.push_back(camera_ray(scene, x0, y0));
                 packet.sample.push_back(x == i && y == j ? 0 : -1);
             }
         }
@@ -178,8 +173,7 @@ std::vector<CameraPacket> camera_packets(const Scene& scene, int i, int j) {
         for (int a = 0; a < n; ++a) {
             double x0, y0;
             sample_position(i, j, a, b, n, scene.width, scene.height, x0, y0);
-            packet.rays.push_back(
-                camera_ray(scene.camera, x0, y0, RaySpans(scene).camera_t_min(), RaySpans(scene).t_max()));
+            packet.rays.push_back(camera_ray(scene, x0, y0));
             packet.sample.push_back(b * n + a);
             if (int(packet.rays.size()) == Accelerator::packet_size || (a == n - 1 && b == n - 1)) {
                 packets.push_back(std::move(packet));

@@ -121,11 +121,13 @@ struct TriangleMesh {
     uint32_t object = 0;  ///< Scene::objects index + 1 (one object per mesh or triangle)
     size_t triangle_count() const { return indices.size() / 3; }
     size_t vertex_count() const { return positions.size() / 4; }
-    /// Vertex `index` in world space (a prototype's mesh: in the prototype's space).
-    Vec3 vertex(size_t index) const {
+    /// Vertex `index` as its float offset from `origin`.
+    Vec3 offset(size_t index) const {
         const float* p = &positions[4 * index];
-        return origin + Vec3(p[0], p[1], p[2]);
+        return {p[0], p[1], p[2]};
     }
+    /// Vertex `index` in world space (a prototype's mesh: in the prototype's space).
+    Vec3 vertex(size_t index) const { return origin + offset(index); }
 };
 
 /// A prototype (docs/scene-format.md §3.8): triangles in a space of their own, stored once and
