@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The OpenImageIO plug-in (lib/libwhitted_oiio.so; why it is separate: whitted/output/plugin.h).
+// The OpenImageIO plug-in (lib/libwhitted_oiio.so; why it is separate: whitted/core/plugin.h).
 // Its entry points are looked up by name with dlsym; both sides are built together by the same
 // compiler, so they pass C++ types.
 

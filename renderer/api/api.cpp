@@ -5,8 +5,8 @@
 #include "api/api_internal.h"
 #include "converters/pov_writer.h"
 #include "reference/check.h"
+#include "whitted/core/plugin.h"
 #include "whitted/output/image_output.h"
-#include "whitted/output/plugin.h"
 #include "whitted/render/distributed.h"
 #include "whitted/render/layers.h"
 #include "whitted/render/renderer.h"
@@ -425,7 +425,7 @@ Expected<CheckResult> check(const std::string& scene_path, const CheckOptions& o
         internal.rule.max_error = options.max_error_codes / 65535.0;
         internal.report_dir = options.report_dir;
         internal.quiet = options.quiet;
-        // `check` lives in the OpenImageIO plug-in (whitted/output/plugin.h), like the program's.
+        // `check` lives in the OpenImageIO plug-in (whitted/core/plugin.h), like the program's.
         // Its errors come back as values: exceptions do not cross into the plug-in's own copy
         // of the libraries. 0: done, 2: bad input, 1: failure.
         using RunCheck =

@@ -8,10 +8,10 @@
 #include "converters/yaml_writer.h"
 #include "explain_command.h"
 #include "reference/check.h"
+#include "whitted/core/plugin.h"
 #include "whitted/output/atomic_files.h"
 #include "whitted/output/color_management.h"
 #include "whitted/output/image_output.h"
-#include "whitted/output/plugin.h"
 #include "whitted/render/accelerator.h"
 #include "whitted/render/distributed.h"
 #include "whitted/render/renderer.h"
@@ -477,7 +477,7 @@ int run_check_command(const std::string& scene_path, reference::CheckOptions opt
     options.cancel = &g_cancel;
     options.exit_at_once = &g_exit_on_signal;
     install_signal_handlers();
-    // `check` lives in the OpenImageIO plug-in (whitted/output/plugin.h); it prints its own errors.
+    // `check` lives in the OpenImageIO plug-in (whitted/core/plugin.h); it prints its own errors.
     using RunCheck = int (*)(const std::string&, const reference::CheckOptions&, const std::atomic<int>&);
     try {
         const auto run_check = reinterpret_cast<RunCheck>(image_io_plugin_symbol("whitted_run_check"));

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "whitted/render/distributed.h"
 
-#include "whitted/output/plugin.h"
+#include "whitted/core/plugin.h"
 
 #include <chrono>
 #include <cstdlib>

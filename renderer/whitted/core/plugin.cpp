@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "whitted/output/plugin.h"
+#include "whitted/core/plugin.h"
 
 #include <dlfcn.h>
 
