@@ -13,9 +13,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <numbers>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -150,6 +152,32 @@ TEST(Triangulate, Combs) {
         SCOPED_TRACE(std::to_string(teeth) + " teeth");
         expect_exact_cover(comb(teeth), (2.0 * teeth - 1) + 3.0 * teeth);
     }
+}
+
+TEST(Triangulate, LargeSimplePolygonsStayExact) {
+    // Thousands of corners that do not turn left, so the ear search does real work: its bound of
+    // n²/2 corner-in-triangle tests must not cut short a polygon that is simple.
+    expect_exact_cover(star(1500, 2.0, 1.0), star_area(1500, 2.0, 1.0));  // 3,000 corners
+    expect_exact_cover(comb(1000), (2.0 * 1000 - 1) + 3.0 * 1000);        // 4,000 corners
+}
+
+TEST(Triangulate, APolygonThatCrossesItselfAtTheCornerLimitGetsItsTriangles) {
+    // 20,000 corners at random points of a 100 × 100 grid: a polygon that crosses itself
+    // everywhere, whose ear search finds no ear in n steps, n times over (55 s before its work
+    // was bounded). It still gets n − 2 triangles of its own corners, each corner cut once.
+    constexpr size_t n = 20000;
+    std::mt19937 random(4620);
+    std::uniform_int_distribution<int> coordinate(0, 99);
+    std::vector<Vec3> corners;
+    for (size_t i = 0; i < n; ++i) corners.push_back({double(coordinate(random)), double(coordinate(random)), 0});
+    const std::vector<uint32_t> triangles = triangulate_polygon(corners);
+    ASSERT_EQ(triangles.size(), 3 * (n - 2));
+    std::vector<int> tips(n, 0);  // the middle corner of each cut is the one cut off
+    for (size_t t = 0; t < triangles.size(); t += 3) {
+        for (size_t k = 0; k < 3; ++k) ASSERT_LT(triangles[t + k], n);
+        if (t + 3 < triangles.size()) ++tips[triangles[t + 1]];
+    }
+    EXPECT_EQ(*std::max_element(tips.begin(), tips.end()), 1) << "a corner was cut off twice";
 }
 
 TEST(Triangulate, CollinearAndRepeatedCorners) {

@@ -832,7 +832,8 @@ void resolve_materials(const std::string& path, ObjContents& contents) {
 }
 
 /// Above this many corners a face that is not convex is refused: ear clipping takes time that
-/// grows with the square of the corners (a second at about this size on one core).
+/// grows with the square of the corners (triangulate_polygon bounds it at n²/2 tests, about 2 s
+/// at this size on one core).
 constexpr size_t max_concave_corners = 20000;
 
 /// Looks again at every polygon, fanned while reading: where the fan is wrong (the polygon is
@@ -1055,21 +1056,56 @@ std::vector<uint32_t> triangulate_polygon(const std::vector<Vec3>& corners) {
     // nothing, and they would otherwise make their neighbours look like non-ears. A simple polygon
     // always has an ear (two, in fact); should none be found (the polygon crosses itself) the
     // corner that turns left most is cut, so that every polygon still gets its n − 2 triangles.
+    //
+    // The time is bounded whatever the corners: each corner's turn is kept and worked out again
+    // only for the two corners beside a cut (nothing else changes), the ear test looks only at
+    // the corners that do not turn left (only they can lie inside an ear), and the corner-in-
+    // triangle tests of the ear search are limited to n²/2 in all. A polygon that needs more
+    // (one that crosses itself, typically: a search then finds no ear in each of n steps) has
+    // its remaining corners cut as a crossing polygon's are, sharpest left turn first.
     std::vector<size_t> previous(n), next(n);
     for (size_t i = 0; i < n; ++i) previous[i] = (i + n - 1) % n, next[i] = (i + 1) % n;
+    std::vector<double> turn(n);
+    std::vector<char> cut_off(n, 0);
+    std::vector<size_t> not_left;  // corners that did not turn left when last looked at
+    size_t flat = 0;               // corners whose turn is 0
+    const auto look_at = [&](size_t i) {
+        if (turn[i] == 0) --flat;
+        turn[i] = polygon.turn(previous[i], i, next[i]);
+        if (turn[i] == 0) ++flat;
+        if (turn[i] <= 0) not_left.push_back(i);  // a corner may be listed twice: harmless
+    };
+    for (size_t i = 0; i < n; ++i) {
+        turn[i] = 1;  // so that look_at counts a flat corner once
+        look_at(i);
+    }
     const auto cut = [&](size_t i) {
         triangles.insert(triangles.end(), {uint32_t(previous[i]), uint32_t(i), uint32_t(next[i])});
         next[previous[i]] = next[i];
         previous[next[i]] = previous[i];
+        cut_off[i] = 1;
+        if (turn[i] == 0) --flat;
+        look_at(previous[i]);
+        look_at(next[i]);
     };
+    uint64_t tests_left = uint64_t(n) * uint64_t(n) / 2;
     const auto is_ear = [&](size_t i) {
         const size_t a = previous[i], c = next[i];
-        if (polygon.turn(a, i, c) <= 0) return false;
+        if (turn[i] <= 0) return false;
         // Only a corner that does not turn left can lie inside an ear of a simple polygon; one
         // at the same place as a corner of the ear (a polygon with a slit to a hole) does not count.
-        for (size_t p = next[c]; p != a; p = next[p]) {
-            if (polygon.turn(previous[p], p, next[p]) > 0) continue;
+        for (size_t k = 0; k < not_left.size();) {
+            const size_t p = not_left[k];
+            if (cut_off[p] || turn[p] > 0) {  // gone, or turns left now: off the list
+                not_left[k] = not_left.back();
+                not_left.pop_back();
+                continue;
+            }
+            ++k;
+            if (p == a || p == i || p == c) continue;
             if (polygon.same_point(p, a) || polygon.same_point(p, i) || polygon.same_point(p, c)) continue;
+            if (tests_left == 0) return false;
+            --tests_left;
             if (polygon.in_triangle(p, a, i, c)) return false;
         }
         return true;
@@ -1078,16 +1114,15 @@ std::vector<uint32_t> triangulate_polygon(const std::vector<Vec3>& corners) {
     while (remaining > 3) {
         size_t chosen = n;
         // A corner that covers nothing, else the first ear from where the last cut was.
-        for (size_t k = 0, j = i; k < remaining && chosen == n; ++k, j = next[j])
-            if (polygon.turn(previous[j], j, next[j]) == 0) chosen = j;
-        for (size_t k = 0, j = i; k < remaining && chosen == n; ++k, j = next[j])
+        if (flat > 0)
+            for (size_t k = 0, j = i; k < remaining && chosen == n; ++k, j = next[j])
+                if (turn[j] == 0) chosen = j;
+        for (size_t k = 0, j = i; k < remaining && chosen == n && tests_left > 0; ++k, j = next[j])
             if (is_ear(j)) chosen = j;
-        if (chosen == n) {  // not a simple polygon: the sharpest left turn
+        if (chosen == n) {  // not a simple polygon (or the tests are used up): the sharpest left turn
             double best = -std::numeric_limits<double>::infinity();
-            for (size_t k = 0, j = i; k < remaining; ++k, j = next[j]) {
-                const double t = polygon.turn(previous[j], j, next[j]);
-                if (t > best) best = t, chosen = j;
-            }
+            for (size_t k = 0, j = i; k < remaining; ++k, j = next[j])
+                if (turn[j] > best) best = turn[j], chosen = j;
         }
         i = next[chosen];
         cut(chosen);
