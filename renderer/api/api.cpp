@@ -10,7 +10,9 @@
 #include "whitted/render/distributed.h"
 #include "whitted/render/layers.h"
 #include "whitted/render/renderer.h"
+#include "whitted/scene/text_checks.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <new>
@@ -97,14 +99,29 @@ LayerSet layers_for(const Scene& scene, const RenderOptions& options) {
     return layers;
 }
 
+/// The crop window in the renderer's terms, refused unless it lies inside the image.
+std::optional<TileRect> crop_window(const Scene& scene, const RenderOptions& options) {
+    if (!options.crop) return std::nullopt;
+    const PixelWindow& w = *options.crop;
+    const int64_t x_end = int64_t(w.x) + w.width, y_end = int64_t(w.y) + w.height;
+    if (w.x < 0 || w.y < 0 || w.width < 1 || w.height < 1 || x_end > scene.width() || y_end > scene.height())
+        throw std::invalid_argument("the crop window " + std::to_string(w.x) + "," + std::to_string(w.y) + "," +
+                                    std::to_string(w.width) + "," + std::to_string(w.height) +
+                                    " (X,Y,WIDTH,HEIGHT) does not lie inside the " + std::to_string(scene.width()) +
+                                    "x" + std::to_string(scene.height()) + " image");
+    return TileRect{w.x, int(x_end), w.y, int(y_end)};
+}
+
 whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& options, LayerSet layers,
                                       WorkExchange* exchange = nullptr) {
+    const std::optional<TileRect> crop = crop_window(scene, options);
     const Accelerator& accelerator = scene.impl().accelerator(options.threads);
     // The progress callback may cancel too: then one flag of ours for both, set by either (the
     // caller's copied in by a watcher); without a callback the tiles check the caller's own.
     std::atomic<bool> stop{options.cancel && options.cancel->load()};
     whitted::RenderOptions internal;
     internal.threads = options.threads;
+    internal.crop = crop;
     internal.layers = layers;
     internal.cancel = options.on_progress || !options.cancel ? &stop : options.cancel;
     std::atomic<bool> watching{true};
@@ -133,6 +150,7 @@ whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& o
     }
     watching.store(false);
     if (watcher.joinable()) watcher.join();
+    if (crop) result.image = crop_image(result.image, *crop);
     return result;
 }
 
@@ -201,19 +219,40 @@ std::vector<std::string> Scene::layers() const {
     return names;
 }
 
-Expected<Scene> load_scene_file(const std::string& path) {
+/// The public overrides in the reader's terms; `intersection` is checked here.
+SettingOverrides setting_overrides(const SceneOverrides& given) {
+    SettingOverrides overrides;
+    overrides.where = "SceneOverrides";
+    if (given.width) overrides.width = *given.width;
+    if (given.height) overrides.height = *given.height;
+    if (given.samples) overrides.samples = *given.samples;
+    if (given.max_depth) overrides.max_depth = *given.max_depth;
+    if (given.intersection) {
+        if (*given.intersection == "exact")
+            overrides.intersection = Intersection::exact;
+        else if (*given.intersection == "povray")
+            overrides.intersection = Intersection::povray;
+        else
+            throw InputError({FileName(overrides.where)},
+                             "intersection must be 'exact' or 'povray', not '" + printable(*given.intersection) + "'");
+    }
+    return overrides;
+}
+
+Expected<Scene> load_scene_file(const std::string& path, const SceneOverrides& overrides) {
     // In one pass (scene.h): the objects are validated as they are read and their descriptions
     // not kept, so a million spheres cost bytes each, not kilobytes; the converters read the
     // file again (Scene::Impl::converter_description).
     return load(path, [&](Scene::Impl& impl) {
-        impl.scene = whitted::load_scene_file(path, &impl.description);
+        impl.scene = whitted::load_scene_file(path, &impl.description, setting_overrides(overrides));
         impl.objects_kept = false;
     });
 }
 
-Expected<Scene> load_scene_string(const std::string& text, const std::string& name) {
+Expected<Scene> load_scene_string(const std::string& text, const std::string& name, const SceneOverrides& overrides) {
     return load(name, [&](Scene::Impl& impl) {
-        impl.description = parse_scene_text(text, name);
+        impl.description = parse_any_scene_text(text, name);
+        apply_overrides(setting_overrides(overrides), impl.description);
         impl.scene = validate_scene(impl.description);
     });
 }
@@ -370,11 +409,14 @@ Expected<RenderResult> render_distributed(const Scene& scene, const RenderOption
 }
 
 Expected<RenderStats> render_into(const Scene& scene, float* rgb, size_t floats, const RenderOptions& options) {
-    const size_t needed = size_t(scene.width()) * size_t(scene.height()) * 3;
+    const int width = options.crop ? options.crop->width : scene.width();
+    const int height = options.crop ? options.crop->height : scene.height();
+    const size_t needed = size_t(std::max(width, 0)) * size_t(std::max(height, 0)) * 3;
     if (!rgb || floats != needed)
         return plain_error("render_into: the buffer holds " + std::to_string(floats) + " floats; the " +
-                               std::to_string(scene.width()) + "x" + std::to_string(scene.height()) + " image needs " +
-                               std::to_string(needed) + " (width*height*3)",
+                               std::to_string(width) + "x" + std::to_string(height) +
+                               (options.crop ? " crop window" : " image") + " needs " + std::to_string(needed) +
+                               " (width*height*3)",
                            Error::Kind::bad_input);
     return guarded<RenderStats>("rendering " + scene.path(), [&]() -> Expected<RenderStats> {
         RenderOptions beauty = options;

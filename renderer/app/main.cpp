@@ -17,22 +17,28 @@
 #include "whitted/render/renderer.h"
 #include "whitted/scene/description.h"
 #include "whitted/scene/scene.h"
+#include "whitted/scene/text_checks.h"
 #include "whitted/whitted.h"
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include <sys/ioctl.h>
 #include <sys/prctl.h>
 #include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cerrno>
+#include <charconv>
 #include <chrono>
 #include <condition_variable>
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <mutex>
@@ -168,16 +174,34 @@ std::string format_duration(double seconds) {
     return fmt::format("{}m{:02d}s", int(seconds / 60), int(seconds) % 60);
 }
 
+/// The terminal's width in columns (80 when it does not say).
+int terminal_columns() {
+    winsize size{};
+    if (::ioctl(STDERR_FILENO, TIOCGWINSZ, &size) == 0 && size.ws_col > 0) return size.ws_col;
+    return 80;
+}
+
+/// One line that fits the terminal, redrawn in place: the bar shrinks (or goes) before the
+/// figures do, and a line never wraps (a wrapped line is left behind at every redraw).
 void draw_progress(const RenderProgress& p) {
     const double fraction = p.tiles_total ? double(p.tiles_done) / double(p.tiles_total) : 1.0;
-    constexpr int width = 30;
-    const int filled = int(fraction * width);
-    std::string bar(filled, '=');
-    if (filled < width) bar += '>' + std::string(width - filled - 1, ' ');
     const double rate = p.seconds > 0 ? double(p.rays) / p.seconds / 1e6 : 0.0;
     const double eta = fraction > 0 ? p.seconds * (1 - fraction) / fraction : 0.0;
-    std::fprintf(stderr, "\r[%s] %5.1f%%  %7.2f M rays/s  elapsed %s  ETA %s   ", bar.c_str(), 100 * fraction, rate,
-                 format_duration(p.seconds).c_str(), fraction > 0 ? format_duration(eta).c_str() : "?");
+    const std::string figures =
+        fmt::format("{:5.1f}%  {:7.2f} M rays/s  elapsed {}  ETA {}", 100 * fraction, rate, format_duration(p.seconds),
+                    fraction > 0 ? format_duration(eta) : std::string("?"));
+    const int columns = terminal_columns() - 1;  // the last column would wrap on some terminals
+    const int width = std::min(30, columns - int(figures.size()) - 3);
+    std::string line;
+    if (width >= 5) {
+        const int filled = int(fraction * width);
+        line = "[" + std::string(filled, '=');
+        if (filled < width) line += '>' + std::string(width - filled - 1, ' ');
+        line += "] ";
+    }
+    line += figures;
+    if (int(line.size()) > columns) line.resize(size_t(std::max(columns, 0)));
+    std::fprintf(stderr, "\r%s\x1b[K", line.c_str());  // ESC[K: clear what a longer line left
     std::fflush(stderr);
 }
 
@@ -189,7 +213,52 @@ struct RenderArguments {
     int bit_depth = 0;
     std::string ocio_config, display, view;
     std::vector<std::string> layers;  // --layers; empty: not given (the scene's render.layers)
+    api::SceneOverrides overrides;    // --width, --height, --samples, --max-depth, --intersection
+    std::string crop;                 // --crop X,Y,WIDTH,HEIGHT; empty: the whole image
 };
+
+/// --crop's X,Y,WIDTH,HEIGHT (the window's place in the image is checked with the scene).
+api::PixelWindow parse_crop(const std::string& text) {
+    api::PixelWindow window;
+    int* const fields[] = {&window.x, &window.y, &window.width, &window.height};
+    const char* p = text.data();
+    const char* const end = text.data() + text.size();
+    for (size_t i = 0; i < 4; ++i) {
+        const auto [next, error] = std::from_chars(p, end, *fields[i]);
+        if (error != std::errc() || (i < 3 ? next == end || *next != ',' : next != end))
+            throw std::invalid_argument("--crop: expected X,Y,WIDTH,HEIGHT in pixels (four whole numbers), not '" +
+                                        printable(text) + "'");
+        p = next + (i < 3 ? 1 : 0);
+    }
+    if (window.x < 0 || window.y < 0 || window.width < 1 || window.height < 1)
+        throw std::invalid_argument("--crop: X and Y must be at least 0, WIDTH and HEIGHT at least 1 (got '" +
+                                    printable(text) + "')");
+    return window;
+}
+
+/// The scene named on the command line: a file, or with `-` the text on standard input (read
+/// whole, at most the scene file limit; relative mesh paths are then relative to the current
+/// directory, and the format is told by the first line: docs/scene-format.md).
+api::Expected<api::Scene> load_scene_argument(const std::string& scene, const api::SceneOverrides& overrides) {
+    if (scene != "-") return api::load_scene_file(scene, overrides);
+    std::string text;
+    char buffer[1 << 16];
+    for (;;) {
+        const ssize_t n = ::read(STDIN_FILENO, buffer, sizeof buffer);
+        if (n == 0) break;
+        if (n < 0) {
+            if (errno == EINTR && !g_cancel.load()) continue;
+            return api::Error{std::string("cannot read the scene from standard input: ") + std::strerror(errno),
+                              "<stdin>"};
+        }
+        if (text.size() + size_t(n) > size_t(limits::max_scene_file_bytes))
+            return api::Error{"the scene on standard input is more than " +
+                                  std::to_string(limits::max_scene_file_bytes) + " bytes, the scene file limit",
+                              "<stdin>"};
+        text.append(buffer, size_t(n));
+    }
+    return api::load_scene_string(text, "<stdin>", overrides);
+}
 
 OutputOptions output_options(const RenderArguments& args) {
     OutputOptions output;
@@ -268,17 +337,19 @@ int run_render(const RenderArguments& args) {
     LayerSet layers;
     std::optional<api::Scene> loaded;
     // Usage first, in milliseconds: nothing here reads the scene.
+    std::optional<api::PixelWindow> crop;
     const auto check_usage = [&] {
+        if (!args.crop.empty()) crop = parse_crop(args.crop);
         check_output_path(args.output);
         if (!args.layers.empty()) {
             layers = parse_layers(args.layers);
             if (!layers.empty()) output.layers_from = "--layers";
         }
         check_output_options(args.output, output);
-        refuse_output_over(args.output, args.scene, "scene file");
+        if (args.scene != "-") refuse_output_over(args.output, args.scene, "scene file");
     };
     if (const int status = exit_on_input_error(args.scene, check_usage); status >= 0) return status;
-    api::Expected<api::Scene> read = api::load_scene_file(args.scene);
+    api::Expected<api::Scene> read = load_scene_argument(args.scene, args.overrides);
     if (!read) return report(read.error());
     loaded.emplace(std::move(read).value());
     const api::Scene::Impl& impl = loaded->impl();
@@ -296,6 +367,9 @@ int run_render(const RenderArguments& args) {
             }
         }
         for (const std::string& mesh : scene.mesh_files) refuse_output_over(args.output, mesh, "mesh file");
+        if (crop && (int64_t(crop->x) + crop->width > scene.width || int64_t(crop->y) + crop->height > scene.height))
+            throw std::invalid_argument("--crop " + args.crop + " does not lie inside the " +
+                                        std::to_string(scene.width) + "x" + std::to_string(scene.height) + " image");
         // The colour layers split each hit's terms at weight 1; a glazed (fresnel_ior) material
         // scales them by 1 − F, which the layers do not yet follow, so they would not add up.
         if (!layers.empty())
@@ -312,6 +386,7 @@ int run_render(const RenderArguments& args) {
         api::RenderOptions options;
         options.threads = args.threads;
         options.layers = args.layers;  // empty: the scene's render.layers, as above
+        options.crop = crop;
         options.cancel = &g_cancel;
         const bool progress_bar = !args.quiet && ::isatty(STDERR_FILENO);
         if (progress_bar)
@@ -346,8 +421,12 @@ int run_render(const RenderArguments& args) {
         const uint64_t rays = result.stats.camera_rays + result.stats.shadow_rays + result.stats.reflected_rays;
         write.metadata = {
             {"whitted:scene", std::filesystem::path(args.scene).filename().string()},
-            {"whitted:settings", fmt::format("{}x{}, {} sample(s)/pixel, max depth {}", scene.width, scene.height,
-                                             scene.samples * scene.samples, scene.max_depth)},
+            {"whitted:settings",
+             fmt::format(
+                 "{}x{}{}, {} sample(s)/pixel, max depth {}, intersection {}", scene.width, scene.height,
+                 crop ? fmt::format(" cropped to {}x{} at {},{}", crop->width, crop->height, crop->x, crop->y) : "",
+                 scene.samples * scene.samples, scene.max_depth,
+                 scene.intersection == Intersection::exact ? "exact" : "povray")},
             {"whitted:render_seconds", fmt::format("{:.3f}", result.stats.seconds)},
             {"whitted:rays", std::to_string(rays)}};
         if (result.cancelled) {
@@ -381,14 +460,18 @@ int run_render(const RenderArguments& args) {
                 double(accelerator.peak_embree_bytes()) / 1e6,
                 accelerator.isa().empty() ? "(its choice)" : accelerator.isa().c_str(), accelerator.lane_width());
         if (!args.quiet)
-            std::fprintf(stderr,
-                         "whitted: %dx%d, %d sample(s)/pixel, %u thread(s): render %.3fs (total %.3fs), %.2f M rays "
-                         "(camera %.2f, shadow %.2f, reflected %.2f), %.1f M rays/s -> %s\n",
-                         scene.width, scene.height, scene.samples * scene.samples,
-                         args.threads > 0 ? unsigned(args.threads) : std::thread::hardware_concurrency(),
-                         result.stats.seconds, total, rays / 1e6, result.stats.camera_rays / 1e6,
-                         result.stats.shadow_rays / 1e6, result.stats.reflected_rays / 1e6,
-                         result.stats.seconds > 0 ? rays / result.stats.seconds / 1e6 : 0.0, args.output.c_str());
+            std::fprintf(
+                stderr,
+                "whitted: %dx%d%s, %d sample(s)/pixel, %u thread(s): render %.3fs (total %.3fs), %.2f M "
+                "rays (camera %.2f, shadow %.2f, reflected %.2f), %.1f M rays/s -> %s\n",
+                scene.width, scene.height,
+                crop ? fmt::format(" cropped to {}x{} at {},{}", crop->width, crop->height, crop->x, crop->y).c_str()
+                     : "",
+                scene.samples * scene.samples,
+                args.threads > 0 ? unsigned(args.threads) : std::thread::hardware_concurrency(), result.stats.seconds,
+                total, rays / 1e6, result.stats.camera_rays / 1e6, result.stats.shadow_rays / 1e6,
+                result.stats.reflected_rays / 1e6, result.stats.seconds > 0 ? rays / result.stats.seconds / 1e6 : 0.0,
+                args.output.c_str());
         return exit_ok;
     } catch (const InputError& e) {  // e.g. a shape beyond the range the accelerator takes
         print_error(e.what());
@@ -583,7 +666,9 @@ int main(int argc, char** argv) {
     RenderArguments render_args;
     CLI::App* render_cmd = app.add_subcommand(
         "render", "Render a scene file (YAML or JSON, format v1; a course .xml scene; an NFF .nff scene) to an image");
-    render_cmd->add_option("scene", render_args.scene, "Scene file")->required()->check(CLI::ExistingFile);
+    render_cmd->add_option("scene", render_args.scene, "Scene file, or - to read the scene from standard input")
+        ->required()
+        ->check(CLI::ExistingFile | CLI::IsMember({"-"}));
     render_cmd
         ->add_option("-o,--output", render_args.output,
                      "Output image: .exr is linear float (scene-referred); .png/.jpg/.tif go through the "
@@ -613,6 +698,30 @@ int main(int argc, char** argv) {
                          "Print the time of each stage (parse, load, BVH, render, write) and the BVH's memory");
     render_cmd->add_flag("--partial", render_args.partial,
                          "If interrupted, still write what was finished (marked partial in the metadata)");
+    render_cmd
+        ->add_option("--width", render_args.overrides.width,
+                     "Image width in pixels, replacing image.width (alone: the height keeps the aspect ratio)")
+        ->check(CLI::Range(1, int(limits::max_image_side)));
+    render_cmd
+        ->add_option("--height", render_args.overrides.height,
+                     "Image height in pixels, replacing image.height (alone: the width keeps the aspect ratio)")
+        ->check(CLI::Range(1, int(limits::max_image_side)));
+    render_cmd
+        ->add_option("--samples", render_args.overrides.samples,
+                     "Samples per pixel side, replacing image.samples (n: n*n rays per pixel)")
+        ->check(CLI::Range(1, int(limits::max_samples)));
+    render_cmd
+        ->add_option("--max-depth", render_args.overrides.max_depth,
+                     "Mirror and refraction bounces, replacing render.max_depth")
+        ->check(CLI::Range(1, int(limits::max_depth)));
+    render_cmd
+        ->add_option("--intersection", render_args.overrides.intersection,
+                     "How hits are decided, replacing render.intersection: exact (the default) or povray "
+                     "(POV-Ray 3.7's decisions, as `whitted check` renders)")
+        ->check(CLI::IsMember({"exact", "povray"}));
+    render_cmd->add_option("--crop", render_args.crop,
+                           "Render only this window of the image, X,Y,WIDTH,HEIGHT in pixels from the top-left "
+                           "corner: the output is WIDTH x HEIGHT, the same pixels as the whole render");
 
     render_cmd
         ->add_option(
@@ -725,6 +834,18 @@ int main(int argc, char** argv) {
         ->check(CLI::NonNegativeNumber);
     compare_cmd->add_flag("--clip", compare_clip, "Clip both images to [0, 1] first (PNG files clip at 1)");
 
+    // A mistyped command gets its nearest name (CLI11 would say only that one is required).
+    if (argc > 1 && argv[1][0] != '-') {
+        std::vector<std::string> commands;
+        for (const CLI::App* command : app.get_subcommands({})) commands.push_back(command->get_name());
+        if (std::find(commands.begin(), commands.end(), argv[1]) == commands.end()) {
+            std::string list;
+            for (const std::string& name : commands) list += (list.empty() ? "" : ", ") + name;
+            print_error("unknown command '" + printable(argv[1]) + "'" + did_you_mean(argv[1], commands) +
+                        "; the commands are " + list + " (whitted --help)");
+            return exit_bad_input;
+        }
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

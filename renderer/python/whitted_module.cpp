@@ -14,6 +14,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -59,6 +60,23 @@ int checked_threads(int threads) {
     return threads;
 }
 
+/// The render's options from the module's arguments; `crop` is None or (x, y, width, height).
+api::RenderOptions render_options(int threads, const std::vector<std::string>& layers, const py::object& crop) {
+    api::RenderOptions options;
+    options.threads = checked_threads(threads);
+    options.layers = layers;
+    if (!crop.is_none()) {
+        std::array<int, 4> window{};
+        try {
+            window = crop.cast<std::array<int, 4>>();
+        } catch (const py::cast_error&) {
+            throw py::value_error("crop: expected (x, y, width, height), four whole numbers");
+        }
+        options.crop = api::PixelWindow{window[0], window[1], window[2], window[3]};
+    }
+    return options;
+}
+
 /// An image's floats as a NumPy array (H×W×C) that owns the Image: no copy.
 py::array_t<float> array_of(std::shared_ptr<whitted::Image> image, float* data, size_t channels) {
     auto* holder = new std::shared_ptr<whitted::Image>(std::move(image));
@@ -72,7 +90,7 @@ py::array_t<float> array_of(std::shared_ptr<whitted::Image> image, float* data, 
 /// api::render on a worker thread; the GIL is released meanwhile and this (calling) thread runs
 /// the signal handlers and `progress` every 50 ms. Rethrows what either raised, after the render
 /// has stopped.
-api::RenderResult render_releasing_gil(const api::Scene& scene, int threads, const std::vector<std::string>& layers,
+api::RenderResult render_releasing_gil(const api::Scene& scene, api::RenderOptions options,
                                        const py::object& progress) {
     std::atomic<bool> cancel{false};
     std::mutex mutex;
@@ -82,9 +100,6 @@ api::RenderResult render_releasing_gil(const api::Scene& scene, int threads, con
     std::optional<api::Expected<api::RenderResult>> result;
     std::optional<py::error_already_set> raised;
 
-    api::RenderOptions options;
-    options.threads = threads;
-    options.layers = layers;
     options.cancel = &cancel;
     options.on_progress = [&](const api::Progress& p) {
         std::lock_guard lock(mutex);
@@ -189,32 +204,48 @@ PYBIND11_MODULE(whitted, m) {
         .def_property_readonly("layers", &api::Scene::layers);
 
     m.def(
-        "load", [](const std::string& path) { return take(api::load_scene_file(path)); }, py::arg("path"),
-        "Read and validate a scene file (YAML/JSON scene format v1, or a course .xml scene). Raises whitted.Error "
-        "naming FILE:LINE:COL.");
+        "load",
+        [](const std::string& path, std::optional<int> width, std::optional<int> height, std::optional<int> samples,
+           std::optional<int> max_depth, std::optional<std::string> intersection) {
+            return take(api::load_scene_file(path, {width, height, samples, max_depth, intersection}));
+        },
+        py::arg("path"), py::kw_only(), py::arg("width") = py::none(), py::arg("height") = py::none(),
+        py::arg("samples") = py::none(), py::arg("max_depth") = py::none(), py::arg("intersection") = py::none(),
+        "Read and validate a scene file (YAML/JSON scene format v1, a course .xml scene, an NFF scene). Raises "
+        "whitted.Error naming FILE:LINE:COL. width, height, samples, max_depth and intersection ('exact' or "
+        "'povray') replace the file's settings, as `whitted render --width ...` does (one side alone keeps the "
+        "aspect ratio).");
     m.def(
         "loads",
-        [](const std::string& text, const std::string& name) { return take(api::load_scene_string(text, name)); },
-        py::arg("text"), py::arg("name") = "<string>",
-        "Read and validate a scene from a string; `name` stands for the file in messages.");
+        [](const std::string& text, const std::string& name, std::optional<int> width, std::optional<int> height,
+           std::optional<int> samples, std::optional<int> max_depth, std::optional<std::string> intersection) {
+            return take(api::load_scene_string(text, name, {width, height, samples, max_depth, intersection}));
+        },
+        py::arg("text"), py::arg("name") = "<string>", py::kw_only(), py::arg("width") = py::none(),
+        py::arg("height") = py::none(), py::arg("samples") = py::none(), py::arg("max_depth") = py::none(),
+        py::arg("intersection") = py::none(),
+        "Read and validate a scene from a string (its format by `name`'s extension, else by its first line); "
+        "`name` stands for the file in messages. Overrides as for load.");
 
     m.def(
         "render",
-        [](const api::Scene& scene, int threads, const py::object& progress) {
-            auto result = render_releasing_gil(scene, checked_threads(threads), {"none"}, progress);
+        [](const api::Scene& scene, int threads, const py::object& progress, const py::object& crop) {
+            auto result = render_releasing_gil(scene, render_options(threads, {"none"}, crop), progress);
             auto image = std::make_shared<whitted::Image>(std::move(result.image));
             float* data = image->rgb.data();
             return array_of(std::move(image), data, 3);
         },
-        py::arg("scene"), py::arg("threads") = 0, py::arg("progress") = py::none(),
+        py::arg("scene"), py::arg("threads") = 0, py::arg("progress") = py::none(), py::arg("crop") = py::none(),
         "Render the scene's beauty: a float32 NumPy array H x W x 3, linear (the pixels of the EXR "
         "`whitted render` writes, bit for bit), without a copy. progress(tiles_done, tiles_total) is called "
         "from this thread a few times a second; an exception it raises (or Ctrl-C) cancels the render and "
-        "propagates. The GIL is released while rendering.");
+        "propagates. The GIL is released while rendering. crop=(x, y, width, height) renders only that window "
+        "of the image (the same pixels as the whole render).");
     m.def(
         "render_layers",
-        [](const api::Scene& scene, const std::vector<std::string>& layers, int threads, const py::object& progress) {
-            auto result = render_releasing_gil(scene, checked_threads(threads), layers, progress);
+        [](const api::Scene& scene, const std::vector<std::string>& layers, int threads, const py::object& progress,
+           const py::object& crop) {
+            auto result = render_releasing_gil(scene, render_options(threads, layers, crop), progress);
             auto image = std::make_shared<whitted::Image>(std::move(result.image));
             py::dict out;
             out["beauty"] = array_of(image, image->rgb.data(), 3);
@@ -223,9 +254,9 @@ PYBIND11_MODULE(whitted, m) {
             return out;
         },
         py::arg("scene"), py::arg("layers") = std::vector<std::string>{}, py::arg("threads") = 0,
-        py::arg("progress") = py::none(),
+        py::arg("progress") = py::none(), py::arg("crop") = py::none(),
         "Render with render layers (docs/layers.md; empty: the scene's render.layers): a dict of arrays, "
-        "'beauty' and one per layer (H x W x channels).");
+        "'beauty' and one per layer (H x W x channels). crop as for render.");
 
     m.def(
         "write_image",

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Fuzzes what runs, not only what parses: any bytes as a scene file (NFF when they begin as an
-// NFF file does, the course's XML when they begin with `<`, YAML otherwise), written to a file
+// Fuzzes what runs, not only what parses: any bytes as a scene file (in the format scene_format
+// tells from the first line, as for a scene on standard input), written to a file
 // and read as `whitted render` reads it (load_scene_file), then rendered through
 // Embree at a few pixels and a shallow depth. The only acceptable refusal is InputError (exit 2
 // in `whitted`), whether the reader or the accelerator raises it; a signal, an Embree assertion,
@@ -19,31 +19,14 @@
 #include <cstdint>
 #include <string>
 
-namespace {
-
-/// An NFF file's first entity, after any `#` comment lines, is a one-letter keyword on its own
-/// word (`v`, `b`, `l`, `f`, `c`, `s`, `p`, `pp`); the seeds from tests/nff begin that way. (A YAML
-/// scene may begin with `#` comments too.)
-bool looks_like_nff(const std::string& text) {
-    size_t line = 0;
-    while (line < text.size() && (text[line] == '#' || text[line] == '\n' || text[line] == '\r')) {
-        const size_t end = text.find('\n', line);
-        if (end == std::string::npos) return false;
-        line = end + 1;
-    }
-    const size_t end = text.find_first_of(" \t\r\n", line);
-    const std::string word = text.substr(line, end == std::string::npos ? std::string::npos : end - line);
-    return word == "v" || word == "b" || word == "l" || word == "f" || word == "c" || word == "s" || word == "p" ||
-           word == "pp";
-}
-
-}  // namespace
-
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     using namespace whitted;
     const std::string text(reinterpret_cast<const char*>(data), size);
     // In the scratch directory, so relative mesh paths find the fixtures (or nothing).
-    const char* const name = looks_like_nff(text) ? "scene.nff" : text.rfind('<', 0) == 0 ? "scene.xml" : "scene.yaml";
+    const SceneFormat format = scene_format("", text);  // as `whitted render -` tells them apart
+    const char* const name = format == SceneFormat::nff          ? "scene.nff"
+                             : format == SceneFormat::course_xml ? "scene.xml"
+                                                                 : "scene.yaml";
     const std::string path = (fuzz::scratch_directory() / name).string();
     fuzz::write_file(path, text);
     try {

@@ -131,9 +131,22 @@ def identical(whitted, directory):
                 problems.append(f"{label}: {differing} pixel(s) differ from the one-process render")
             print(f"{label}: {seconds:.2f}s, {'identical' if not differing else 'DIFFERENT'} "
                   f"({w}x{h}, {s}x{s} samples, {threads} thread(s) per rank)")
+        # A crop window shared among 3 ranks: the one-process render's pixels in that window. The
+        # window starts and ends inside tiles, so partial tiles are cut on rank 0.
+        x, y, cw, ch = 45, 70, 200, 101
+        output = os.path.join(directory, f"{name}-crop.exr")
+        command = mpirun_prefix(3) + [whitted, "render", scene, "-o", output, "-t", "1", "--crop", f"{x},{y},{cw},{ch}"]
+        run = subprocess.run(command, env=mpi_env(), capture_output=True, text=True, timeout=300)
+        if run.returncode != 0:
+            problems.append(f"{name}, --crop on 3 ranks: exit {run.returncode}: {run.stderr.strip()[-2000:]}")
+            continue
+        got, window = read_exr(output), expected[y:y + ch, x:x + cw]
+        if got.shape != window.shape or not numpy.array_equal(got, window):
+            problems.append(f"{name}, --crop on 3 ranks: not the one-process render's window ({got.shape})")
+        print(f"{name}, --crop {x},{y},{cw},{ch} on 3 ranks: {'identical' if not problems else 'see above'}")
     if problems:
         fail("\n  ".join(problems))
-    print("PASS: every distributed render equals the one-process render float for float")
+    print("PASS: every distributed render (whole, and a crop window) equals the one-process render float for float")
 
 
 def big_scene(directory):

@@ -252,3 +252,63 @@ def test_every_error_path_raises(case, tmp_path):
         assert result.stdout.split()[1] == "True", "whitted.Error is a RuntimeError"
     # Nothing half-written is left behind.
     assert not [p for p in os.listdir(tmp_path) if "tmp" in p], os.listdir(tmp_path)
+
+
+def test_overrides_act_as_the_files_own_settings():
+    with open(SHADOWS) as f:
+        text = f.read()
+    scene = whitted.load(SHADOWS)
+    w, h = scene.width, scene.height
+    # One side alone keeps the aspect ratio, rounded to the nearest pixel (half away from zero).
+    narrow = whitted.load(SHADOWS, width=101, samples=2, max_depth=2, intersection="povray")
+    assert (narrow.width, narrow.height) == (101, int(101 * h / w + 0.5))
+    assert (narrow.samples, narrow.max_depth) == (2, 2)
+    tall = whitted.loads(text, "shadows.yaml", height=77)
+    assert (tall.width, tall.height) == (int(77 * w / h + 0.5), 77)
+    # The same pixels as the scene with those values written into it.
+    import yaml
+    written = yaml.safe_load(text)
+    written["image"].update({"width": 101, "height": narrow.height, "samples": 2})
+    written.setdefault("render", {}).update({"max_depth": 2, "intersection": "povray"})
+    same = whitted.loads(yaml.safe_dump(written), SHADOWS)
+    assert np.array_equal(whitted.render(narrow), whitted.render(same))
+
+
+@pytest.mark.parametrize("overrides, fragment", [
+    ({"width": 0}, "image.width must be at least 1"),
+    ({"height": 70000}, "the limit is 65536 per side"),
+    ({"samples": 17}, "image.samples must be between 1 and 16"),
+    ({"max_depth": 0}, "render.max_depth must be between 1 and 256"),
+    ({"intersection": "fast"}, "intersection must be 'exact' or 'povray'"),
+])
+def test_a_bad_override_is_an_error_naming_it(overrides, fragment):
+    with pytest.raises(whitted.Error) as raised:
+        whitted.load(SHADOWS, **overrides)
+    assert fragment in str(raised.value)
+    assert raised.value.file == "SceneOverrides" and raised.value.kind == "bad_input"
+
+
+def test_crop_is_the_whole_renders_window_bit_for_bit():
+    scene = whitted.load(SHADOWS, width=130, samples=2)
+    whole = whitted.render(scene, threads=2)
+    for x, y, w, h in [(0, 0, scene.width, scene.height), (129, scene.height - 1, 1, 1), (7, 33, 60, 41)]:
+        part = whitted.render(scene, threads=1, crop=(x, y, w, h))
+        assert part.shape == (h, w, 3)
+        assert np.array_equal(part, whole[y:y + h, x:x + w])
+    layers = whitted.render_layers(scene, ["diffuse", "Z"], crop=(7, 33, 60, 41))
+    all_layers = whitted.render_layers(scene, ["diffuse", "Z"])
+    for name in ("beauty", "diffuse", "Z"):
+        assert np.array_equal(layers[name], all_layers[name][33:74, 7:67])
+
+
+@pytest.mark.parametrize("crop", [(0, 0, 0, 1), (-1, 0, 2, 2), (120, 0, 11, 5), (0, 0, 1, 10**6)])
+def test_a_crop_outside_the_image_is_an_error(crop):
+    scene = whitted.load(SHADOWS, width=130)
+    with pytest.raises(whitted.Error, match="does not lie inside the 130x"):
+        whitted.render(scene, crop=crop)
+
+
+@pytest.mark.parametrize("crop", [(1, 2, 3), "0,0,1,1", (0.5, 0, 1, 1), (0, 0, 1, 10**12)])
+def test_a_crop_that_is_not_four_whole_numbers_is_a_value_error(crop):
+    with pytest.raises(ValueError, match="crop: expected"):
+        whitted.render(whitted.load(SHADOWS), crop=crop)

@@ -309,4 +309,63 @@ TEST(LoadScene, AMeshKeepsItsFloatsWhereverItIsMoved) {
 }
 
 }  // namespace
+
+TEST(SceneFormat, TheExtensionFirstThenTheFirstLine) {
+    EXPECT_EQ(scene_format("a.xml", "version: 1"), SceneFormat::course_xml);
+    EXPECT_EQ(scene_format("a.NFF", "version: 1"), SceneFormat::nff);
+    EXPECT_EQ(scene_format("<stdin>", "# a comment\n#another\nv\nfrom 0 0 1\n"), SceneFormat::nff);
+    for (const char* keyword : {"v", "b", "l", "f", "c", "s", "p", "pp"})
+        EXPECT_EQ(scene_format("<stdin>", std::string(keyword) + " 1 2 3\n"), SceneFormat::nff) << keyword;
+    EXPECT_EQ(scene_format("<stdin>", "\n  <scene>\n"), SceneFormat::course_xml);
+    EXPECT_EQ(scene_format("<stdin>", "# comment\nversion: 1\n"), SceneFormat::yaml);
+    EXPECT_EQ(scene_format("<stdin>", "{\"version\": 1}"), SceneFormat::yaml);
+    EXPECT_EQ(scene_format("<stdin>", "view: 1\n"), SceneFormat::yaml);  // a word, not an NFF keyword
+    EXPECT_EQ(scene_format("<stdin>", "# only a comment"), SceneFormat::yaml);
+    EXPECT_EQ(scene_format("<stdin>", ""), SceneFormat::yaml);
+}
+
+TEST(SettingOverrides, ReplaceTheFilesValuesBeforeTheyAreChecked) {
+    const std::string text = test::join_lines({
+        "camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}",
+        "image: {width: 97, height: 61, samples: 3}",
+        "render: {max_depth: 7}",
+        "objects: [{type: sphere, center: [0, 0, 0], radius: 1, material: {kd: 0.5}}]",
+    });
+    SettingOverrides overrides;
+    overrides.width = 50;  // alone: height = round(50 · 61 / 97) = round(31.44) = 31
+    overrides.max_depth = 2;
+    overrides.intersection = Intersection::povray;
+    Scene scene = load_scene_text(text, "scene.yaml", nullptr, overrides);
+    EXPECT_EQ(scene.width, 50);
+    EXPECT_EQ(scene.height, 31);
+    EXPECT_EQ(scene.samples, 3);  // not overridden
+    EXPECT_EQ(scene.max_depth, 2);
+    EXPECT_EQ(scene.intersection, Intersection::povray);
+    // The camera follows the new aspect ratio, as for a file that says 50 × 31.
+    const Scene written = load_scene_text(
+        test::join_lines({"camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}", "image: {width: 50, height: 31}",
+                          "objects: [{type: sphere, center: [0, 0, 0], radius: 1, material: {kd: 0.5}}]"}),
+        "scene.yaml");
+    EXPECT_EQ(scene.camera.up.y, written.camera.up.y);
+    EXPECT_EQ(scene.camera.right.x, written.camera.right.x);
+
+    SettingOverrides tall;
+    tall.height = 20;  // alone: width = round(20 · 97 / 61) = round(31.80) = 32
+    scene = load_scene_text(text, "scene.yaml", nullptr, tall);
+    EXPECT_EQ(scene.width, 32);
+    EXPECT_EQ(scene.height, 20);
+
+    // The file's limits hold, and the message names the override.
+    SettingOverrides huge;
+    huge.width = 65536;  // height round(65536 · 61 / 97) = 41213: past 2^28 pixels
+    huge.where = "--width";
+    const auto error = test::input_error_from([&] { load_scene_text(text, "scene.yaml", nullptr, huge); });
+    ASSERT_TRUE(error);
+    EXPECT_EQ(error->where().file.str(), "--width");
+    EXPECT_NE(std::string(error->what()).find("65536x41213"), std::string::npos) << error->what();
+    SettingOverrides deep;
+    deep.max_depth = 300;
+    EXPECT_TRUE(test::input_error_from([&] { load_scene_text(text, "scene.yaml", nullptr, deep); }));
+}
+
 }  // namespace whitted

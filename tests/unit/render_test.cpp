@@ -112,6 +112,33 @@ TEST_P(RenderPerSamples, EveryPixelHoldsTheRenderPixelValue) {
     EXPECT_EQ(differing, 0);
 }
 
+// A crop window traces only the tiles it overlaps, and its pixels are the whole render's: a
+// window across the two tiles' boundary (32-pixel tiles over 41 columns), and one inside the
+// first tile alone, whose camera rays are that tile's 32 × 23 pixels' and no more.
+TEST_P(RenderPerSamples, ACropWindowIsTheWholeRendersPixels) {
+    const int samples = GetParam();
+    const Scene scene = test::scene_from(scene_text(samples));
+    const Accelerator accelerator(scene, 2);
+    RenderOptions options;
+    options.threads = 2;
+    const RenderResult whole = render(scene, accelerator, options);
+    for (const TileRect window : {TileRect{20, 35, 5, 15}, TileRect{1, 6, 1, 6}, TileRect{0, 41, 0, 23}}) {
+        options.crop = window;
+        const RenderResult cropped = render(scene, accelerator, options);
+        const Image part = crop_image(cropped.image, window);
+        ASSERT_EQ(part.width, window.x_end - window.x_begin);
+        ASSERT_EQ(part.height, window.y_end - window.y_begin);
+        EXPECT_TRUE(same_pixels(part, crop_image(whole.image, window)))
+            << "window from " << window.x_begin << "," << window.y_begin;
+        if (window.x_end <= render_tile_size)
+            EXPECT_EQ(cropped.rays.camera, uint64_t(render_tile_size) * 23 * samples * samples);
+    }
+    // crop_image itself: the window's rows, each from its first column.
+    const Image corner = crop_image(whole.image, {40, 41, 22, 23});
+    ASSERT_EQ(corner.rgb.size(), 3u);
+    EXPECT_EQ(std::memcmp(corner.rgb.data(), whole.image.pixel(40, 22), 3 * sizeof(float)), 0);
+}
+
 INSTANTIATE_TEST_SUITE_P(OneAndNxN, RenderPerSamples, testing::Values(1, 2, 3),
                          [](const testing::TestParamInfo<int>& samples_info) {
                              return "samples" + std::to_string(samples_info.param);

@@ -135,12 +135,26 @@ private:
     std::unique_ptr<Impl> m_impl;
 };
 
-/// Reads and validates a scene file: YAML or JSON scene format v1 (docs/scene-format.md), or a
-/// Cornell CS4620 course .xml scene (docs/course-format.md). Mesh files are read too.
-WHITTED_API Expected<Scene> load_scene_file(const std::string& path);
+/// Settings given from outside the scene, as `whitted render --width ... --intersection` gives
+/// them: each replaces the file's value before the scene is checked, so the file's limits hold
+/// (an Error names the setting). A width without a height, or a height without a width, keeps the
+/// scene's aspect ratio, the other side rounded to the nearest pixel.
+struct SceneOverrides {
+    std::optional<int> width, height;
+    std::optional<int> samples;               ///< image.samples: n×n rays per pixel, 1..16
+    std::optional<int> max_depth;             ///< render.max_depth, 1..256
+    std::optional<std::string> intersection;  ///< render.intersection: "exact" or "povray"
+};
+
+/// Reads and validates a scene file: YAML or JSON scene format v1 (docs/scene-format.md), a
+/// Cornell CS4620 course .xml scene (docs/course-format.md) or an NFF scene (docs/nff.md). Mesh
+/// files are read too.
+WHITTED_API Expected<Scene> load_scene_file(const std::string& path, const SceneOverrides& overrides = {});
 /// The same from text in memory; `name` stands for the file in messages, and relative mesh
-/// paths are resolved against its directory.
-WHITTED_API Expected<Scene> load_scene_string(const std::string& text, const std::string& name = "<string>");
+/// paths are resolved against its directory. The format is the one `name`'s extension says
+/// (.xml, .nff), else the one the text's first line says (NFF entities, XML's `<`, else YAML).
+WHITTED_API Expected<Scene> load_scene_string(const std::string& text, const std::string& name = "<string>",
+                                              const SceneOverrides& overrides = {});
 
 /// A point, direction or RGB colour.
 struct Vec3 {
@@ -191,8 +205,17 @@ struct Progress {
     double seconds = 0;
 };
 
+/// A rectangle of pixels: its top-left corner (column, row from the top-left, 0-based) and size.
+struct PixelWindow {
+    int x = 0, y = 0, width = 0, height = 0;
+};
+
 struct RenderOptions {
     int threads = 0;  ///< 0 = all cores; the image is bit-identical for any number
+    /// Render only this window of the image (`whitted render --crop`): the result is an image of
+    /// the window's size whose pixels are the whole render's, bit for bit. It must lie inside
+    /// the image.
+    std::optional<PixelWindow> crop;
     /// Render layers (docs/layers.md), as `whitted render --layers`: "all", or names such as
     /// "diffuse", "N". Empty: the scene's render.layers; {"none"}: none.
     std::vector<std::string> layers;
@@ -217,8 +240,9 @@ struct RenderResult {
 /// Renders the scene. Cancelling is not an error: the result says cancelled.
 WHITTED_API Expected<RenderResult> render(const Scene& scene, const RenderOptions& options = {});
 /// Renders the beauty into the caller's buffer: `floats` must be width·height·3 (R G B per
-/// pixel, rows from the top). A cancelled render returns an Error of kind cancelled (the
-/// buffer then holds the finished tiles). Layers are not available this way.
+/// pixel, rows from the top; the crop window's width and height with a crop). A cancelled
+/// render returns an Error of kind cancelled (the buffer then holds the finished tiles). Layers
+/// are not available this way.
 WHITTED_API Expected<RenderStats> render_into(const Scene& scene, float* rgb, size_t floats,
                                               const RenderOptions& options = {});
 

@@ -3,6 +3,7 @@
 
 #include "whitted/core/plugin.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -57,43 +58,60 @@ RenderResult render_distributed(const Scene& scene, const Accelerator& accelerat
             "render layers are not available in a distributed (MPI) render yet; render them in one process");
     using clock = std::chrono::steady_clock;
     const auto start = clock::now();
-    const size_t tile_count = render_tile_count(scene.width, scene.height);
+    // The exchange hands out items 0..item_count−1: every tile, or the crop window's (ascending).
+    const std::vector<size_t> cropped =
+        options.crop ? render_tiles_overlapping(scene, *options.crop) : std::vector<size_t>{};
+    const size_t item_count = options.crop ? cropped.size() : render_tile_count(scene.width, scene.height);
+    const auto tile_of = [&](size_t item) { return options.crop ? cropped[item] : item; };
+    const auto item_of = [&](size_t tile) {
+        return options.crop ? size_t(std::lower_bound(cropped.begin(), cropped.end(), tile) - cropped.begin()) : tile;
+    };
     const bool root = exchange.rank() == 0;
 
     // Rank 0 keeps the other ranks' tiles as they arrive (from the exchange's thread, while its
     // own render writes into its image) and copies them in afterwards.
-    std::vector<std::vector<float>> received(root ? tile_count : 0);
+    std::vector<std::vector<float>> received(root ? item_count : 0);
     std::atomic<uint64_t> remote_camera{0}, remote_shadow{0}, remote_reflected{0};
     std::atomic<bool> bad_payload{false};
-    const auto receive = [&](size_t tile, const void* payload, size_t bytes) {
-        const TileRect rect = render_tile_rect(scene.width, scene.height, tile);
-        if (tile >= tile_count || bytes != sizeof(TileHeader) + rect.pixels() * 3 * sizeof(float)) {
+    const auto receive = [&](size_t item, const void* payload, size_t bytes) {
+        if (item >= item_count) {
+            bad_payload = true;
+            return;
+        }
+        const TileRect rect = render_tile_rect(scene.width, scene.height, tile_of(item));
+        if (bytes != sizeof(TileHeader) + rect.pixels() * 3 * sizeof(float)) {
             bad_payload = true;
             return;
         }
         TileHeader header;
         std::memcpy(&header, payload, sizeof header);
         remote_camera += header.camera, remote_shadow += header.shadow, remote_reflected += header.reflected;
-        std::vector<float>& pixels = received[tile];
+        std::vector<float>& pixels = received[item];
         pixels.resize(rect.pixels() * 3);
         std::memcpy(pixels.data(), static_cast<const char*>(payload) + sizeof header, pixels.size() * sizeof(float));
     };
-    exchange.begin(tile_count, receive, options.cancel);
+    exchange.begin(item_count, receive, options.cancel);
 
     const auto remote_rays = [&] { return remote_camera.load() + remote_shadow.load() + remote_reflected.load(); };
     const auto report = [&](RenderProgress progress) {
         progress.tiles_done = exchange.items_done();
-        progress.tiles_total = tile_count;
+        progress.tiles_total = item_count;
         progress.rays += remote_rays();
         progress.seconds = std::chrono::duration<double>(clock::now() - start).count();
         options.on_progress(progress);
     };
 
     RenderOptions local = options;
-    local.next_tile = [&](size_t& tile) { return exchange.next_item(tile); };
+    local.crop.reset();  // the items are the window's tiles already
+    local.next_tile = [&](size_t& tile) {
+        size_t item;
+        if (!exchange.next_item(item)) return false;
+        tile = tile_of(item);
+        return true;
+    };
     local.on_tile_done = [&](size_t tile, const Image& image, const RayCounts& counts) {
         if (root) {
-            exchange.item_done(tile, nullptr, 0);
+            exchange.item_done(item_of(tile), nullptr, 0);
             return;
         }
         const TileRect rect = render_tile_rect(scene.width, scene.height, tile);
@@ -105,7 +123,7 @@ RenderResult render_distributed(const Scene& scene, const Accelerator& accelerat
         const size_t row_bytes = size_t(rect.x_end - rect.x_begin) * 3 * sizeof(float);
         for (int y = rect.y_begin; y < rect.y_end; ++y, out += row_bytes)
             std::memcpy(out, image.pixel(rect.x_begin, y), row_bytes);
-        exchange.item_done(tile, buffer.data(), buffer.size());
+        exchange.item_done(item_of(tile), buffer.data(), buffer.size());
     };
     local.on_progress = nullptr;
     if (root && options.on_progress) local.on_progress = report;
@@ -119,10 +137,10 @@ RenderResult render_distributed(const Scene& scene, const Accelerator& accelerat
         throw std::runtime_error("a rank sent a tile of the wrong size (do all ranks read the same scene?)");
 
     if (root) {
-        for (size_t tile = 0; tile < tile_count; ++tile) {
-            const std::vector<float>& pixels = received[tile];
+        for (size_t item = 0; item < item_count; ++item) {
+            const std::vector<float>& pixels = received[item];
             if (pixels.empty()) continue;  // rendered here, or (cancelled) never
-            const TileRect rect = render_tile_rect(scene.width, scene.height, tile);
+            const TileRect rect = render_tile_rect(scene.width, scene.height, tile_of(item));
             const size_t row_floats = size_t(rect.x_end - rect.x_begin) * 3;
             for (int y = rect.y_begin; y < rect.y_end; ++y)
                 std::memcpy(&result.image.rgb[3 * (size_t(y) * scene.width + rect.x_begin)],

@@ -196,10 +196,45 @@ TileRect render_tile_rect(int width, int height, size_t t) {
     return {x_begin, std::min(x_begin + tile, width), y_begin, std::min(y_begin + tile, height)};
 }
 
+std::vector<size_t> render_tiles_overlapping(const Scene& scene, const TileRect& window) {
+    std::vector<size_t> tiles;
+    const size_t count = render_tile_count(scene.width, scene.height);
+    for (size_t t = 0; t < count; ++t)
+        if (render_tile_rect(scene.width, scene.height, t).overlaps(window)) tiles.push_back(t);
+    return tiles;
+}
+
+Image crop_image(const Image& image, const TileRect& window) {
+    Image out;
+    out.width = window.x_end - window.x_begin;
+    out.height = window.y_end - window.y_begin;
+    const auto cut = [&](const std::vector<float>& values, size_t channels) {
+        std::vector<float> kept;
+        kept.reserve(window.pixels() * channels);
+        for (int y = window.y_begin; y < window.y_end; ++y) {
+            const auto row =
+                values.begin() + ptrdiff_t((size_t(y) * size_t(image.width) + size_t(window.x_begin)) * channels);
+            kept.insert(kept.end(), row, row + ptrdiff_t(size_t(out.width) * channels));
+        }
+        return kept;
+    };
+    out.rgb = cut(image.rgb, 3);
+    for (const ImageLayer& layer : image.layers) {
+        out.layers.push_back({layer.name, layer.channels, layer.data, cut(layer.values, layer.channels.size())});
+    }
+    return out;
+}
+
 RenderResult render(const Scene& scene, const Accelerator& accelerator, const RenderOptions& options) {
     using clock = std::chrono::steady_clock;
     const auto start = clock::now();
-    const size_t tile_count = render_tile_count(scene.width, scene.height);
+    // The tiles to render: every one, or those the crop window overlaps (a tile source, when
+    // there is one, decides for itself).
+    std::vector<size_t> cropped_tiles;
+    if (options.crop && !options.next_tile) cropped_tiles = render_tiles_overlapping(scene, *options.crop);
+    const size_t tile_count =
+        options.crop && !options.next_tile ? cropped_tiles.size() : render_tile_count(scene.width, scene.height);
+    const auto tile_number = [&](size_t i) { return options.crop && !options.next_tile ? cropped_tiles[i] : i; };
 
     RenderResult result;
     result.image.width = scene.width;
@@ -264,9 +299,9 @@ RenderResult render(const Scene& scene, const Accelerator& accelerator, const Re
             return;
         }
         tbb::parallel_for(tbb::blocked_range<size_t>(0, tile_count, 1), [&](const tbb::blocked_range<size_t>& range) {
-            for (size_t t = range.begin(); t != range.end(); ++t) {
+            for (size_t i = range.begin(); i != range.end(); ++i) {
                 if (cancelled()) return;
-                render_tile(t);
+                render_tile(tile_number(i));
             }
         });
     });

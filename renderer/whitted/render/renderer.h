@@ -9,6 +9,7 @@
 
 #include <atomic>
 #include <functional>
+#include <optional>
 #include <vector>
 
 namespace whitted {
@@ -21,8 +22,21 @@ struct RenderProgress {
     double seconds = 0;
 };
 
+/// A rectangle of pixels, [x_begin, x_end) × [y_begin, y_end).
+struct TileRect {
+    int x_begin, x_end, y_begin, y_end;
+    size_t pixels() const { return size_t(x_end - x_begin) * size_t(y_end - y_begin); }
+    bool overlaps(const TileRect& other) const {
+        return x_begin < other.x_end && other.x_begin < x_end && y_begin < other.y_end && other.y_begin < y_end;
+    }
+};
+
 struct RenderOptions {
     int threads = 0;  ///< 0 = all cores
+    /// Render only the tiles that overlap this window of the image (`whitted render --crop`):
+    /// the image is still the whole image, black outside those tiles; crop_image() cuts it out.
+    /// Each pixel is the one the whole render gives, bit for bit.
+    std::optional<TileRect> crop;
     /// Render layers to compute. With any, the beauty is the float sum of the colour layers
     /// (docs/layers.md); without, the render takes the path that knows nothing of layers.
     LayerSet layers;
@@ -42,10 +56,6 @@ struct RenderOptions {
 
 /// render() works in square tiles of this many pixels a side, numbered row by row.
 constexpr int render_tile_size = 32;
-struct TileRect {
-    int x_begin, x_end, y_begin, y_end;
-    size_t pixels() const { return size_t(x_end - x_begin) * size_t(y_end - y_begin); }
-};
 size_t render_tile_count(int width, int height);
 TileRect render_tile_rect(int width, int height, size_t tile);
 
@@ -55,6 +65,11 @@ struct RenderResult {
     double seconds = 0;
     bool cancelled = false;
 };
+
+/// The tiles (their numbers, ascending) that overlap `window`.
+std::vector<size_t> render_tiles_overlapping(const Scene& scene, const TileRect& window);
+/// The window's pixels of `image` (every layer too), as an image of the window's size.
+Image crop_image(const Image& image, const TileRect& window);
 
 /// Renders the scene in tiles on all (or `threads`) cores. Every pixel depends only on the
 /// scene, never on the order tiles finish, so the image is bit-identical for any thread count.

@@ -244,6 +244,15 @@ SceneDescription parse_scene_file(const std::string& path, const ObjectSink* sin
 /// Same, from text already in memory; `path` is used for messages and relative mesh paths.
 SceneDescription parse_scene_text(std::string_view text, const std::string& path, const ObjectSink* sink = nullptr);
 
+/// The three kinds of scene text Whitted reads.
+enum class SceneFormat { yaml, course_xml, nff };
+/// A scene's format by its name's extension (`.xml`, `.nff`, as parse_scene_file decides), else
+/// by how its text begins: NFF's one-letter entities (after `#` comment lines), XML's `<`, else
+/// YAML (JSON included). For text with no file name, such as a scene on standard input.
+SceneFormat scene_format(const std::string& path, std::string_view text);
+/// parse_scene_text, parse_course_xml_text or parse_nff_text, as scene_format says.
+SceneDescription parse_any_scene_text(std::string_view text, const std::string& path, const ObjectSink* sink = nullptr);
+
 const char* to_string(ObjectType type);
 
 }  // namespace whitted

@@ -776,15 +776,54 @@ SceneDescription parse_scene_text(std::string_view text, const std::string& path
     return parse_text(text, path, sink, {});
 }
 
+namespace {
+
+/// A description read whole, its objects handed to `sink` as a streaming reader would.
+SceneDescription hand_objects_to(const ObjectSink* sink, SceneDescription description) {
+    if (sink) {
+        for (size_t i = 0; i < description.objects.size(); ++i) (*sink)(std::move(description.objects[i]), i);
+        description.objects.clear();
+    }
+    return description;
+}
+
+}  // namespace
+
+SceneFormat scene_format(const std::string& path, std::string_view text) {
+    if (is_course_xml_path(path)) return SceneFormat::course_xml;
+    if (is_nff_path(path)) return SceneFormat::nff;
+    // An NFF file's first entity, after any `#` comment lines, is a one-letter keyword on its own
+    // word (a YAML scene may begin with `#` comments too, then a key such as `version:`).
+    size_t line = 0;
+    while (line < text.size() && (text[line] == '#' || text[line] == '\n' || text[line] == '\r')) {
+        const size_t end = text.find('\n', line);
+        if (end == std::string_view::npos) return SceneFormat::yaml;
+        line = end + 1;
+    }
+    const std::string_view rest = text.substr(line);
+    const std::string_view word = rest.substr(0, rest.find_first_of(" \t\r\n"));
+    for (const std::string_view keyword : {"v", "b", "l", "f", "c", "s", "p", "pp"})
+        if (word == keyword) return SceneFormat::nff;
+    const size_t first = text.find_first_not_of(" \t\r\n");
+    if (first != std::string_view::npos && text[first] == '<') return SceneFormat::course_xml;
+    return SceneFormat::yaml;
+}
+
+SceneDescription parse_any_scene_text(std::string_view text, const std::string& path, const ObjectSink* sink) {
+    switch (scene_format(path, text)) {
+        case SceneFormat::nff:
+            return parse_nff_text(text, path, sink);
+        case SceneFormat::course_xml:
+            return hand_objects_to(sink, parse_course_xml_text(std::string(text), path));
+        case SceneFormat::yaml:
+            break;
+    }
+    return parse_scene_text(text, path, sink);
+}
+
 SceneDescription parse_scene_file(const std::string& path, const ObjectSink* sink) {
-    if (is_course_xml_path(path)) {  // the Cornell course's XML scenes: small; handed over whole
-        SceneDescription description = parse_course_xml_file(path);
-        if (sink) {
-            for (size_t i = 0; i < description.objects.size(); ++i) (*sink)(std::move(description.objects[i]), i);
-            description.objects.clear();
-        }
-        return description;
-    }                                                          // the Cornell course's XML scenes
+    // The Cornell course's XML scenes are small: read whole, then handed over.
+    if (is_course_xml_path(path)) return hand_objects_to(sink, parse_course_xml_file(path));
     if (is_nff_path(path)) return parse_nff_file(path, sink);  // Eric Haines' NFF (docs/nff.md)
     // Mapped, not copied; devices, fifos and other files that are not regular files are refused
     // before a byte is read (/dev/urandom would never end).

@@ -11,7 +11,9 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace whitted {
@@ -192,14 +194,29 @@ struct Scene {
 /// InputError naming file:line:col for anything out of range.
 Scene validate_scene(const SceneDescription& description);
 
+/// Settings given from outside the file (`whitted render --width ...`, api::SceneOverrides). Each
+/// replaces the file's value before anything is checked, so the file's limits hold for it; its
+/// place in messages is `where` (the option's name). A width without a height (or the other way
+/// round) keeps the scene's aspect ratio, the other side rounded to the nearest pixel.
+struct SettingOverrides {
+    std::optional<int64_t> width, height, samples, max_depth;
+    std::optional<Intersection> intersection;
+    std::string where = "<overrides>";
+};
+void apply_overrides(const SettingOverrides& overrides, SceneDescription& description);
+
 /// parse_scene_file and validate_scene in one pass: each top-level object is validated as soon as
 /// it is parsed and its description let go, so that a file of a million spheres never holds a
 /// million descriptions (docs/performance.md, "Reading large scenes"). The same checks, the same
 /// mistake reported, the same Scene as validate_scene(parse_scene_file(path)). `settings`, if
 /// given, receives the description without its objects.
-Scene load_scene_file(const std::string& path, SceneDescription* settings = nullptr);
-/// Same, from text already in memory (as parse_scene_text).
-Scene load_scene_text(std::string_view text, const std::string& path, SceneDescription* settings = nullptr);
+/// `overrides` replace settings of the file before they are checked.
+Scene load_scene_file(const std::string& path, SceneDescription* settings = nullptr,
+                      const SettingOverrides& overrides = {});
+/// Same, from text already in memory, in the format its name's extension says (.nff, .xml), else
+/// the one its first line says (scene_format_of_text).
+Scene load_scene_text(std::string_view text, const std::string& path, SceneDescription* settings = nullptr,
+                      const SettingOverrides& overrides = {});
 
 /// Builds the camera's basis from its description (also used by the converters' tests).
 Camera make_camera(const CameraDescription& camera, int width, int height);

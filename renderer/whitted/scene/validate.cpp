@@ -2,18 +2,20 @@
 // SceneDescription → Scene: range checks that need whole values (or several of them), material
 // names resolved, transforms folded, meshes loaded. Every refusal names file:line:col.
 
-#include "whitted/render/layers.h"
+#include "whitted/scene/layer_names.h"
 #include "whitted/scene/mesh_file.h"
 #include "whitted/scene/msh_file.h"
 #include "whitted/scene/scene.h"
 #include "whitted/scene/text_checks.h"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <filesystem>
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <string_view>
 #include <unordered_map>
 
@@ -772,7 +774,7 @@ namespace {
 
 /// The one pass of load_scene_file/_text: `parse` reads the file, handing each object to the sink.
 template <class Parse>
-Scene load_scene(const Parse& parse, SceneDescription* settings) {
+Scene load_scene(const Parse& parse, SceneDescription* settings, const SettingOverrides& overrides) {
     Scene scene;
     auto builder = std::make_unique<SceneBuilder>(scene);
     bool started = false;
@@ -785,6 +787,7 @@ Scene load_scene(const Parse& parse, SceneDescription* settings) {
         builder->add_top_level(object);
     };
     SceneDescription d = parse(&sink);
+    apply_overrides(overrides, d);
     validate_settings(d, scene);
     builder->finish(d);
     check_triangle_limit(scene);
@@ -794,12 +797,42 @@ Scene load_scene(const Parse& parse, SceneDescription* settings) {
 
 }  // namespace
 
-Scene load_scene_file(const std::string& path, SceneDescription* settings) {
-    return load_scene([&](const ObjectSink* sink) { return parse_scene_file(path, sink); }, settings);
+void apply_overrides(const SettingOverrides& overrides, SceneDescription& d) {
+    const SourceLocation where{FileName(overrides.where)};
+    const auto set = [&](auto& field, const auto& value) {
+        if (!value) return;
+        field.value = *value;
+        field.where = where;
+        field.given = true;
+    };
+    // One side alone keeps the file's aspect ratio (at least one pixel; a file's own sides are
+    // checked below, so a bad one is reported as it stands).
+    const int64_t file_width = d.image.width.value, file_height = d.image.height.value;
+    const bool file_sides_valid = file_width >= 1 && file_height >= 1;
+    // (Clamped far beyond the image limit, so that the rounding stays within int64_t.)
+    const auto side = [](int64_t given, int64_t numerator, int64_t denominator) {
+        const double exact = double(given) * double(numerator) / double(denominator);
+        return std::optional<int64_t>(std::llround(std::clamp(exact, 1.0, 1e15)));
+    };
+    if (overrides.width && !overrides.height && file_sides_valid && *overrides.width >= 1)
+        set(d.image.height, side(*overrides.width, file_height, file_width));
+    if (overrides.height && !overrides.width && file_sides_valid && *overrides.height >= 1)
+        set(d.image.width, side(*overrides.height, file_width, file_height));
+    set(d.image.width, overrides.width);
+    set(d.image.height, overrides.height);
+    set(d.image.samples, overrides.samples);
+    set(d.max_depth, overrides.max_depth);
+    set(d.intersection, overrides.intersection);
 }
 
-Scene load_scene_text(std::string_view text, const std::string& path, SceneDescription* settings) {
-    return load_scene([&](const ObjectSink* sink) { return parse_scene_text(text, path, sink); }, settings);
+Scene load_scene_file(const std::string& path, SceneDescription* settings, const SettingOverrides& overrides) {
+    return load_scene([&](const ObjectSink* sink) { return parse_scene_file(path, sink); }, settings, overrides);
+}
+
+Scene load_scene_text(std::string_view text, const std::string& path, SceneDescription* settings,
+                      const SettingOverrides& overrides) {
+    return load_scene([&](const ObjectSink* sink) { return parse_any_scene_text(text, path, sink); }, settings,
+                      overrides);
 }
 
 }  // namespace whitted

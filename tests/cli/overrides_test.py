@@ -1,0 +1,177 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""`whitted render`'s overrides (docs/cli.md): --width/--height/--samples/--max-depth/
+--intersection replace the scene's settings as if the file said them, --crop renders a window
+whose pixels are the whole render's bit for bit, `-` reads the scene from standard input, and
+every mistake is a usage error (exit 2) before any work, leaving an existing output as it was.
+
+Each expectation is derived from the rule, not from a render of this code: the size from the
+aspect-ratio rule, the crop from the whole render's own pixels, stdin from the file's render,
+an override from the same scene with the value written into the file.
+
+Usage: overrides_test.py WHITTED SOURCE_DIR WORK_DIR
+"""
+import os
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import OpenImageIO as oiio
+import yaml
+
+whitted, source, work = sys.argv[1:4]
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+failures = []
+
+
+def run(args, expect=0, stdin=None):
+    result = subprocess.run([whitted, *args], capture_output=True, cwd=work, input=stdin)
+    if result.returncode != expect:
+        failures.append(f"{' '.join(args)}: exit {result.returncode}, expected {expect}\n"
+                        f"{result.stderr.decode(errors='replace')}")
+    return result
+
+
+def read_exr(name):
+    image = oiio.ImageInput.open(os.path.join(work, name))
+    if image is None:
+        failures.append(f"cannot read {name}: {oiio.geterror()}")
+        return np.zeros((0, 0, 3), np.float32)
+    pixels = image.read_image(format="float")
+    image.close()
+    return pixels
+
+
+def check(condition, message):
+    if not condition:
+        failures.append(message)
+
+
+# A small lecture scene with a mirror (depth matters), rendered at an odd size.
+scene_path = os.path.join(source, "examples", "lecture", "09-glazed-floor.yaml")
+with open(scene_path) as f:
+    scene = yaml.safe_load(f)
+scene["image"].update({"width": 97, "height": 61})
+base = os.path.join(work, "base.yaml")
+with open(base, "w") as f:
+    yaml.safe_dump(scene, f)
+
+
+def written(name, **changes):
+    """The base scene with settings written into the file, as the overrides should act."""
+    variant = yaml.safe_load(yaml.safe_dump(scene))
+    for key, value in changes.items():
+        section, field = key.split(".")
+        variant.setdefault(section, {})[field] = value
+    path = os.path.join(work, name)
+    with open(path, "w") as f:
+        yaml.safe_dump(variant, f)
+    return path
+
+
+# --- overrides act as the file's own settings ---------------------------------------------------
+cases = [
+    (["--width", "40", "--height", "30"], {"image.width": 40, "image.height": 30}),
+    # One side alone keeps the aspect ratio: 97x61 at width 50 -> round(50*61/97) = round(31.44) = 31.
+    (["--width", "50"], {"image.width": 50, "image.height": 31}),
+    # Height 20 -> round(20*97/61) = round(31.80) = 32.
+    (["--height", "20"], {"image.width": 32, "image.height": 20}),
+    (["--samples", "2"], {"image.samples": 2}),
+    (["--max-depth", "1"], {"render.max_depth": 1}),
+    (["--intersection", "povray"], {"render.intersection": "povray"}),
+]
+for i, (args, changes) in enumerate(cases):
+    run(["render", base, "-q", "-o", f"over{i}.exr", *args])
+    run(["render", written(f"written{i}.yaml", **changes), "-q", "-o", f"written{i}.exr"])
+    a, b = read_exr(f"over{i}.exr"), read_exr(f"written{i}.exr")
+    check(a.shape == b.shape and np.array_equal(a, b),
+          f"{' '.join(args)}: not the image of the scene that says {changes} ({a.shape} vs {b.shape})")
+# The samples and depth overrides change the image, so their comparisons above could fail; the
+# intersection rule (the same image on this scene) is named in the file's metadata.
+run(["render", base, "-q", "-o", "file.exr"])
+for i in (3, 4):
+    check(not np.array_equal(read_exr(f"over{i}.exr"), read_exr("file.exr")),
+          f"{' '.join(cases[i][0])}: the same image as without it")
+settings = oiio.ImageInput.open(os.path.join(work, "over5.exr")).spec().getattribute("whitted:settings")
+check("intersection povray" in str(settings), f"--intersection povray: metadata says {settings!r}")
+
+# --- the crop window is the whole render's pixels --------------------------------------------------
+run(["render", base, "-q", "-o", "whole.exr", "--samples", "2"])
+whole = read_exr("whole.exr")
+for x, y, w, h in [(0, 0, 97, 61), (0, 0, 1, 1), (96, 60, 1, 1), (31, 17, 40, 33), (5, 40, 92, 21)]:
+    name = f"crop_{x}_{y}_{w}_{h}.exr"
+    run(["render", base, "-q", "-o", name, "--samples", "2", "--crop", f"{x},{y},{w},{h}"])
+    part = read_exr(name)
+    check(part.shape == (h, w, 3), f"--crop {x},{y},{w},{h}: image is {part.shape}")
+    check(part.shape == (h, w, 3) and np.array_equal(part, whole[y:y + h, x:x + w]),
+          f"--crop {x},{y},{w},{h}: pixels differ from the whole render's")
+# Cropped layers too.
+run(["render", base, "-q", "-o", "whole_layers.exr", "--layers", "diffuse,N"])
+run(["render", base, "-q", "-o", "crop_layers.exr", "--layers", "diffuse,N", "--crop", "10,11,12,13"])
+check(np.array_equal(read_exr("crop_layers.exr"), read_exr("whole_layers.exr")[11:24, 10:22]),
+      "--crop with --layers: the layers differ from the whole render's")
+
+# --- the scene on standard input -------------------------------------------------------------------
+with open(base, "rb") as f:
+    text = f.read()
+run(["render", "-", "-q", "-o", "stdin.exr"], stdin=text)
+check(np.array_equal(read_exr("stdin.exr"), read_exr("file.exr")), "render - : not the file's image")
+# NFF and course XML on standard input are told by their first line.
+nff = b"v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 16 12\nb 0 0 0\n" \
+      b"l 3 3 3\nf 1 0 0 0.8 0 1 0 1\ns 0 0 0 1\n"
+with open(os.path.join(work, "ball.nff"), "wb") as f:
+    f.write(nff)
+run(["render", "-", "-q", "-o", "stdin_nff.exr"], stdin=nff)
+run(["render", "ball.nff", "-q", "-o", "file_nff.exr"])
+check(np.array_equal(read_exr("stdin_nff.exr"), read_exr("file_nff.exr")), "render - (NFF): not the file's image")
+# A bad scene on standard input is named <stdin> with its line and column.
+lines = text.split(b"\n")
+width_line = next(i for i, line in enumerate(lines) if b"width: 97" in line)
+lines[width_line] = lines[width_line].replace(b"97", b"x")
+bad = run(["render", "-", "-q", "-o", "bad_stdin.exr"], expect=2, stdin=b"\n".join(lines))
+check(f"<stdin>:{width_line + 1}:".encode() in bad.stderr, f"render - (bad): not at its line: {bad.stderr!r}")
+
+# --- mistakes are usage errors before any work, and the output stays -------------------------------
+with open(os.path.join(work, "keep.exr"), "wb") as f:
+    f.write(b"previous image")
+usage = [
+    (["--crop", "1,2,3"], "X,Y,WIDTH,HEIGHT"),
+    (["--crop", "1,2,3,4,5"], "X,Y,WIDTH,HEIGHT"),
+    (["--crop", "a,b,c,d"], "X,Y,WIDTH,HEIGHT"),
+    (["--crop", "0,0,0,5"], "at least 1"),
+    (["--crop", "-1,0,5,5"], "at least 0"),
+    (["--crop", "90,0,8,5"], "does not lie inside the 97x61 image"),
+    (["--crop", "0,60,1,2"], "does not lie inside the 97x61 image"),
+    (["--crop", "0,0,10,10", "--width", "5"], "does not lie inside the 5x3 image"),
+    (["--width", "0"], "--width"),
+    (["--width", "65537"], "--width"),
+    (["--height", "-3"], "--height"),
+    (["--samples", "17"], "--samples"),
+    (["--max-depth", "0"], "--max-depth"),
+    (["--max-depth", "257"], "--max-depth"),
+    (["--intersection", "fast"], "--intersection"),
+    (["--width", "65536", "--height", "65536"], "the limit is 65536 per side and 268435456 pixels"),
+]
+for args, fragment in usage:
+    result = run(["render", base, "-q", "-o", "keep.exr", *args], expect=2)
+    check(fragment.encode() in result.stderr, f"{' '.join(args)}: message lacks '{fragment}': {result.stderr!r}")
+with open(os.path.join(work, "keep.exr"), "rb") as f:
+    check(f.read() == b"previous image", "a refused render changed its output")
+# A huge width alone: the height follows within the limit check, not an overflow.
+result = run(["render", base, "-q", "-o", "keep.exr", "--width", "65536"], expect=2)
+check(f"65536x{int(65536 * 61 / 97 + 0.5)}".encode() in result.stderr, f"--width 65536: {result.stderr!r}")
+
+# --- suggestions ------------------------------------------------------------------------------------
+result = run(["rendr", base], expect=2)
+check(b"did you mean 'render'" in result.stderr, f"rendr: {result.stderr!r}")
+result = run(["render", base, "-o", "x.exr", "--layers", "difuse"], expect=2)
+check(b"did you mean 'diffuse'" in result.stderr, f"--layers difuse: {result.stderr!r}")
+result = run(["\x1b]0;title\x07"], expect=2)
+check(b"\x1b" not in result.stderr, f"an escape sequence reached the terminal: {result.stderr!r}")
+
+if failures:
+    print("FAIL:\n" + "\n".join(failures))
+    sys.exit(1)
+print("PASS: overrides, crop, standard input, usage errors, suggestions")
