@@ -12,7 +12,7 @@
 #include "whitted/core/ray.h"
 #include "whitted/geometry/shapes.h"
 #include "whitted/output/atomic_files.h"
-#include "whitted/render/povray_order.h"
+#include "whitted/compat/povray/tie_order.h"
 #include "whitted/scene/mesh_file.h"
 #include "whitted/scene/msh_file.h"
 #include "whitted/scene/scene.h"

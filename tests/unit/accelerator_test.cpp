@@ -5,6 +5,7 @@
 // packets); and WHITTED_EMBREE_ISA is checked by name.
 
 #include "whitted/render/accelerator.h"
+#include "whitted/compat/povray/mesh2.h"
 #include "whitted/geometry/shapes.h"
 #include "whitted/scene/scene.h"
 

@@ -4,7 +4,7 @@
 // (pov.cube_field, pov.cube_field_turned); here, what holds without POV-Ray: the nearest hit is
 // never lost, the order without a hierarchy is the file's, and what is not covered says so.
 
-#include "whitted/render/povray_order.h"
+#include "whitted/compat/povray/tie_order.h"
 
 #include "whitted/geometry/shapes.h"
 #include "whitted/scene/scene.h"

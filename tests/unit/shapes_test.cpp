@@ -3,6 +3,8 @@
 // shapes' definitions (for a transformed sphere, the gradient of its implicit equation).
 
 #include "whitted/geometry/shapes.h"
+#include "whitted/compat/povray/box.h"
+#include "whitted/compat/povray/mesh2.h"
 #include "whitted/core/transform.h"
 
 #include <gtest/gtest.h>
@@ -157,7 +159,7 @@ TEST(Box, NearAnEdgeTheFaceFollowsPovRaysRule) {
     const auto hit_at = [&](double dx, double dy, double delta, ShapeHit& hit) {
         const Vec3 d = normalize(Vec3{dx, -dy, 0});
         const Vec3 on_face{-1, 1 - delta, 0.25};
-        return intersect_box(box, ray_from(on_face - d * 4, d), t_min, t_max, hit, Intersection::povray);
+        return intersect_box_as_povray(box, ray_from(on_face - d * 4, d), t_min, t_max, hit);
     };
     ShapeHit hit;
     // Steep (|d.y| = 2|d.x|): crossings δ/|d.y| apart.
@@ -174,7 +176,7 @@ TEST(Box, NearAnEdgeTheFaceFollowsPovRaysRule) {
     // +z face 1e-7 inside the +x edge is reported on +z if |d.z| > |d.x|.
     const Vec3 d = normalize(Vec3{-1, 0, -3});
     const Vec3 on_face{1 - 1e-7, 0.5, 1};
-    ASSERT_TRUE(intersect_box(box, ray_from(on_face - d * 4, d), t_min, t_max, hit, Intersection::povray));
+    ASSERT_TRUE(intersect_box_as_povray(box, ray_from(on_face - d * 4, d), t_min, t_max, hit));
     expect_vec_near(hit.normal, {0, 0, 1}, 0.0);
     EXPECT_NEAR(hit.t, 4 - 1e-7 * std::sqrt(10.0), 1e-9);  // x's crossing, held first
 }

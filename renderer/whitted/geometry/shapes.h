@@ -20,12 +20,14 @@ struct ShapeHit {
     bool edge_tie = false;
 };
 
+/// The ray in a shape's own space: the direction is not renormalised, so t means the same
+/// distance along the world ray in both spaces.
+Ray to_object_space(const Transform& to_world, const Ray& ray);
+
 bool intersect_sphere(const Sphere& sphere, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
-/// The slab test. `rule` exact: no tolerance but t_min; a ray through an edge or corner gets the
-/// face of the last axis it crosses there. `rule` povray: POV-Ray 3.7's constants and edge rule
-/// (docs/pov-model.md §3, "Box edges"), for `whitted check`.
-bool intersect_box(const Box& box, const Ray& ray, double t_min, double t_max, ShapeHit& hit,
-                   Intersection rule = Intersection::exact);
+/// The slab test, exact: no tolerance but t_min; a ray through an edge or corner gets the face
+/// of the last axis it crosses there. (POV-Ray's, for `whitted check`: compat/povray/box.h.)
+bool intersect_box(const Box& box, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
 /// The side as a quadric in the cone's own frame (the axis and the plane across it), then the
 /// caps as discs unless the cone is open; the nearest hit. Exact in double: no tolerance but
 /// t_min. The side's normal is the gradient of |p⊥| − r(s), scaled by r(s).
@@ -37,27 +39,6 @@ bool intersect_plane(const Plane& plane, const Ray& ray, double t_min, double t_
 /// rounding, which the exact test alone does not promise.
 bool intersect_triangle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Ray& ray, double t_min, double t_max,
                         ShapeHit& hit, double edge_margin = 0);
-/// POV-Ray's own test for a triangle of a mesh2, so that Whitted decides triangle hits as it
-/// does (docs/pov-model.md §3). p1, p2, p3 are the triangle's float vertices in the mesh2's
-/// space, in the order of its face; origin and direction are the ray there (POV-Ray's own ray:
-/// the direction unit length). The plane is kept in single precision, its unit normal and its
-/// distance from the origin each rounded to float; the ray meets that plane at `depth` (along
-/// `direction`), which must be at least 1e-6 and at most 1e7, else false. `inside`: whether the
-/// point there lies inside the triangle as seen along the normal's largest axis, by POV-Ray's
-/// three edge tests in double. A ray within 1e-10 of parallel to the plane (in that float
-/// normal) never meets it. For a ray at a grazing angle θ the float plane moves the point along
-/// the ray by up to about ulp(distance) / θ: at 1e-4 rad and coordinates near 5, by 5e-3.
-bool intersect_mesh2_triangle(const Vec3& p1, const Vec3& p2, const Vec3& p3, const Vec3& origin, const Vec3& direction,
-                              double& depth, bool& inside);
-/// POV-Ray's smooth normal for a mesh2 triangle (vertices p1, p2, p3 and their unit float
-/// normals n1, n2, n3, in the face's order) at `point`, before it is made unit length: the
-/// barycentric blend of the lecture, computed POV-Ray's way (a float vector across the edge
-/// p2 p3 gives the weight u of that edge, the largest axis of p3 − p2 the position v along it,
-/// and n1 + u (n2 − n1 + v (n3 − n2)); n1 itself where u < 1e-10), so that a mirror ray
-/// leaving at a grazing angle leaves as POV-Ray's does.
-Vec3 mesh2_smooth_normal(const Vec3& p1, const Vec3& p2, const Vec3& p3, const Vec3& n1, const Vec3& n2, const Vec3& n3,
-                         const Vec3& point);
-
 /// World-space bounds of a sphere, box or cone (its object-space box pushed through the transform).
 void world_bounds(const Sphere& sphere, Vec3& lo, Vec3& hi);
 void world_bounds(const Box& box, Vec3& lo, Vec3& hi);

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 #include "whitted/render/accelerator.h"
 
+#include "whitted/compat/povray.h"
 #include "whitted/core/packet_array.h"
 #include "whitted/geometry/shapes.h"
-#include "whitted/render/povray_order.h"
 
 #include <embree3/rtcore.h>
 
@@ -34,13 +34,6 @@ namespace whitted {
 namespace {
 
 enum class ShapeKind : uint32_t { triangles, spheres, boxes, cones, instances };
-
-/// A ray taken into an instance's prototype space, in double. The direction is not
-/// renormalised, so t along it is the world t: ranges and distances carry over unchanged.
-Ray to_object_space(const Ray& ray, const Transform& object_to_world) {
-    return {object_to_world.inverse_point(ray.origin), object_to_world.inverse_vector(ray.direction), ray.t_min,
-            ray.t_max};
-}
 
 /// Embree's context, extended with the double-precision rays of the query: user-geometry
 /// callbacks read them back from the pointer Embree passes them (Embree's ray `id` is the index
@@ -105,7 +98,10 @@ bool intersect_analytic(const AnalyticGeometry& geometry, unsigned prim, const R
         return intersect_sphere(geometry.scene->spheres[prim], ray, ray.t_min, t_max, hit);
     if (geometry.kind == ShapeKind::cones)
         return intersect_cone(geometry.scene->cones[prim], ray, ray.t_min, t_max, hit);
-    return intersect_box(geometry.scene->boxes[prim], ray, ray.t_min, t_max, hit, geometry.scene->intersection);
+    const Box& box = geometry.scene->boxes[prim];
+    return geometry.scene->intersection == Intersection::povray
+               ? intersect_box_as_povray(box, ray, ray.t_min, t_max, hit)
+               : intersect_box(box, ray, ray.t_min, t_max, hit);
 }
 
 /// Whether Scene::objects number `object` (index + 1) is a cylinder or cone.
@@ -298,7 +294,7 @@ void triangle_filter(const RTCFilterFunctionNArguments* args) {
         const unsigned inst = RTCHitN_instID(args->hit, args->N, i, 0);
         const Ray ray = inst == RTC_INVALID_GEOMETRY_ID
                             ? context->rays[id]
-                            : to_object_space(context->rays[id], *(*geometry->instance_transforms)[inst]);
+                            : to_object_space(*(*geometry->instance_transforms)[inst], context->rays[id]);
         ShapeHit hit;
         if (!hit_triangle_in_double(*geometry->mesh, RTCHitN_primID(args->hit, args->N, i), ray, geometry->as_povray,
                                     inst != RTC_INVALID_GEOMETRY_ID, hit))
@@ -551,30 +547,6 @@ Vec3 vertex_normal(const TriangleMesh& mesh, uint32_t index) {
     const float* n = &mesh.normals[3 * size_t(index)];
     return {n[0], n[1], n[2]};
 }
-
-/// Whether a mesh is decided as POV-Ray decides it (hit_triangle_in_double) and, if so, its vertex
-/// normals as POV-Ray holds them: made unit length again as they are read, then stored as
-/// floats (POV-Ray's parse.cpp). Computed once here rather than at each hit (blended_normal).
-struct MeshAsPovray {
-    bool decided = false;
-    std::vector<float> normals;  ///< 3 per vertex; empty unless decided and the mesh has normals
-
-    MeshAsPovray(const TriangleMesh& mesh, Intersection rule) : decided(rule == Intersection::povray) {
-        if (!decided || mesh.normals.empty()) return;
-        normals.resize(mesh.normals.size());
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.normals.size() / 3, 8192),
-                          [&](const tbb::blocked_range<size_t>& range) {
-                              for (size_t i = range.begin(); i != range.end(); ++i) {
-                                  const Vec3 n = vertex_normal(mesh, uint32_t(i));
-                                  const double inverse = 1.0 / std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
-                                  // Stored into floats: rounded whatever the vectoriser does.
-                                  normals[3 * i] = float(n.x * inverse);
-                                  normals[3 * i + 1] = float(n.y * inverse);
-                                  normals[3 * i + 2] = float(n.z * inverse);
-                              }
-                          });
-    }
-};
 
 /// Embree's own allocations, counted as they happen (--stats reports the peak: the BVH and
 /// its build's scratch memory).
@@ -1068,7 +1040,7 @@ struct Accelerator::Impl {
                 const Transform& to_world = instance.object_to_world;
                 const TriangleMesh& mesh = scene.prototypes[instance.prototype].meshes[geom];
                 const MeshAsPovray& povray = prototype_povray[instance.prototype][geom];
-                if (!hit_triangle_in_double(mesh, prim, to_object_space(ray, to_world), povray.decided, true, hit))
+                if (!hit_triangle_in_double(mesh, prim, to_object_space(to_world, ray), povray.decided, true, hit))
                     return retry = true, false;
                 const double handedness = to_world.determinant() < 0 ? -1.0 : 1.0;
                 out.geometric_normal = normalize(to_world.apply_normal(hit.normal)) * handedness;

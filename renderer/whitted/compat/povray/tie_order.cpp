@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
-#include "whitted/render/povray_order.h"
+#include "whitted/compat/povray/tie_order.h"
+
+#include "whitted/compat/povray/box.h"
 
 #include <algorithm>
 #include <cmath>
@@ -523,7 +525,7 @@ bool PovrayTestOrder::test(const Ray& ray, uint32_t shape, ShapeHit& hit) const 
     const size_t spheres = m_scene.spheres.size();
     if (shape < spheres) return intersect_sphere(m_scene.spheres[shape], ray, ray.t_min, ray.t_max, hit);
     if (shape < spheres + m_scene.boxes.size())
-        return intersect_box(m_scene.boxes[shape - spheres], ray, ray.t_min, ray.t_max, hit, Intersection::povray);
+        return intersect_box_as_povray(m_scene.boxes[shape - spheres], ray, ray.t_min, ray.t_max, hit);
     return false;  // a plane (finish_hit weighs planes) or a mesh: not a candidate here
 }
 
