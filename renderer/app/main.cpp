@@ -33,6 +33,7 @@
 #include <cerrno>
 #include <charconv>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <csignal>
 #include <cstdint>
@@ -446,6 +447,16 @@ int run_render(const RenderArguments& args) {
         if (const auto written = api::write_image(result.image, args.output, write); !written)
             return report(written.error());
         const double write_seconds = timer.lap();
+        // Radiance past the largest float is +inf in the image, as IEEE arithmetic has it: said,
+        // because only a scene of enormous colours, intensities or mirror weights gets there.
+        const size_t beyond_float = size_t(std::count_if(result.image.rgb.begin(), result.image.rgb.end(),
+                                                         [](float value) { return std::isinf(value); }));
+        if (beyond_float > 0)
+            std::fprintf(stderr,
+                         "whitted: warning: %zu pixel value(s) exceed the largest float (about 3.4e38) and are "
+                         "stored as +inf (clipped to 1 in PNG, JPEG and TIFF): the scene's colours or intensities "
+                         "are that large\n",
+                         beyond_float);
         const double total = timer.total();
         if (args.stats)
             std::fprintf(

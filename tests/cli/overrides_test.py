@@ -4,6 +4,7 @@
 --intersection replace the scene's settings as if the file said them, --crop renders a window
 whose pixels are the whole render's bit for bit, `-` reads the scene from standard input, and
 every mistake is a usage error (exit 2) before any work, leaving an existing output as it was.
+Also: the nearest-name suggestions, and the warning for pixels past the largest float.
 
 Each expectation is derived from the rule, not from a render of this code: the size from the
 aspect-ratio rule, the crop from the whole render's own pixels, stdin from the file's render,
@@ -170,6 +171,17 @@ result = run(["render", base, "-o", "x.exr", "--layers", "difuse"], expect=2)
 check(b"did you mean 'diffuse'" in result.stderr, f"--layers difuse: {result.stderr!r}")
 result = run(["\x1b]0;title\x07"], expect=2)
 check(b"\x1b" not in result.stderr, f"an escape sequence reached the terminal: {result.stderr!r}")
+
+# --- radiance past the largest float -----------------------------------------------------------------
+# A colour of 1e258 (a fuzzer's find): the pixels are +inf in the EXR, and the render says so.
+overflow = os.path.join(source, "tests", "fuzz", "regressions", "fuzz_render", "colour_1e258_overflows_the_pixel.nff")
+result = run(["render", overflow, "-q", "-o", "overflow.exr"])
+image = read_exr("overflow.exr")
+count = int(np.isinf(image).sum())
+check(count > 0 and f"warning: {count} pixel value(s) exceed the largest float".encode() in result.stderr,
+      f"overflow: {count} inf values, stderr {result.stderr!r}")
+result = run(["render", base, "-q", "-o", "finite.exr"])
+check(b"warning" not in result.stderr, f"a finite render warned: {result.stderr!r}")
 
 if failures:
     print("FAIL:\n" + "\n".join(failures))
