@@ -2,8 +2,8 @@
 #pragma once
 
 #include "compare.h"
-#include "whitted/render/layers.h"
 #include "whitted/scene/description.h"
+#include "whitted/scene/layer_names.h"
 
 #include <atomic>
 #include <stdexcept>

@@ -44,7 +44,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (result.image.width != scene.width || result.image.height != scene.height) __builtin_trap();
         // Every radiance the lecture's model gives is a number and not negative: its terms are
         // products and sums of non-negative numbers, clamped by max(0, ·). (Not always finite: a
-        // colour of 1e258 overflows the float pixel, which validation does not bound yet.)
+        // colour of 1e258 overflows the float pixel: no colour is bounded, and `whitted render` warns.)
         for (const float value : result.image.rgb)
             if (!(value >= 0)) __builtin_trap();
     } catch (const InputError& e) {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
-#include "whitted/render/renderer.h"
+#include "whitted/image.h"
 
 #include <string>
 #include <utility>

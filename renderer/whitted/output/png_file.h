@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include "whitted/image.h"
 #include "whitted/output/color_management.h"
-#include "whitted/render/renderer.h"
 
 #include <string>
 #include <utility>
