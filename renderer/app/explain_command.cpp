@@ -198,6 +198,36 @@ void print_text(const Scene& scene, const std::string& path, const PixelExplanat
                 fmt::format("({}, {}, {})", e.layer_beauty[0], e.layer_beauty[1], e.layer_beauty[2]).c_str());
 }
 
+/// The pixel in a dozen lines: what the first sample's camera ray hit, each of the lecture's
+/// terms averaged over the samples (the render layers of the pixel), and the pixel itself.
+void print_summary(const Scene& scene, const std::string& path, const PixelExplanation& e) {
+    const int n = scene.samples;
+    std::printf("pixel (%d, %d) of %s: %dx%d, %d sample(s) per pixel, max depth %d\n", e.x, e.y, path.c_str(),
+                scene.width, scene.height, n * n, scene.max_depth);
+    const ExplainedSegment& first = e.samples.front().segments.front();
+    if (first.hit)
+        std::printf("  first hit (sample 0): %s, %s, at t = %s\n", object_label(scene, first.surface.object).c_str(),
+                    material_label(scene, first.surface.material).c_str(), fmt::format("{}", first.surface.t).c_str());
+    else
+        std::printf("  first hit (sample 0): none, the background\n");
+    const PathLayers& c = e.layers.sum;
+    const auto term = [](const char* name, const Color& value) {
+        std::printf("  %-13s %s\n", name, vec(value).c_str());
+    };
+    term("ambient", c.ambient);
+    term("diffuse", c.diffuse);
+    term("specular", c.specular);
+    term("mirror", c.mirror);
+    term("transmission", c.transmission);
+    term("background", c.background);
+    for (size_t k = 0; k < c.lights.size(); ++k)
+        std::printf("  %-13s %s  (diffuse + specular of %s at the first hit)\n", fmt::format("light{}", k + 1).c_str(),
+                    vec(c.lights[k]).c_str(), light_label(scene, k).c_str());
+    std::printf("  pixel         %s  (the EXR's R, G, B: %s)\n", vec(e.pixel).c_str(),
+                fmt::format("({}, {}, {})", e.rgb[0], e.rgb[1], e.rgb[2]).c_str());
+    std::printf("(whitted explain without --summary: every sample, segment and light with its numbers)\n");
+}
+
 nlohmann::json to_json(const Scene& scene, const std::string& path, const PixelExplanation& e) {
     using nlohmann::json;
     json samples = json::array();
@@ -302,7 +332,7 @@ void print_error(const std::string& message) {
 
 }  // namespace
 
-int run_explain(const std::string& scene_path, const std::string& pixel, bool json, int threads) {
+int run_explain(const std::string& scene_path, const std::string& pixel, bool json, bool summary, int threads) {
     Scene scene;
     int x = 0, y = 0;
     try {
@@ -326,6 +356,8 @@ int run_explain(const std::string& scene_path, const std::string& pixel, bool js
         const PixelExplanation explanation = explain_pixel(scene, accelerator, x, y);
         if (json)
             std::printf("%s\n", to_json(scene, scene_path, explanation).dump(2).c_str());
+        else if (summary)
+            print_summary(scene, scene_path, explanation);
         else
             print_text(scene, scene_path, explanation);
     } catch (const InputError& e) {  // e.g. a shape beyond the range the accelerator takes

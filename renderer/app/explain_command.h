@@ -5,8 +5,9 @@
 
 namespace whitted {
 
-/// `whitted explain SCENE --pixel X,Y [--json]`: prints every term of the pixel's equation
-/// (docs/layers.md). Returns the exit status: 0, 1 (failure while tracing), 2 (bad input or usage).
-int run_explain(const std::string& scene_path, const std::string& pixel, bool json, int threads);
+/// `whitted explain SCENE --pixel X,Y [--json | --summary]`: prints every term of the pixel's
+/// equation, or (--summary) each term averaged over its samples (docs/layers.md). Returns the
+/// exit status: 0, 1 (failure while tracing), 2 (bad input or usage).
+int run_explain(const std::string& scene_path, const std::string& pixel, bool json, bool summary, int threads);
 
 }  // namespace whitted

@@ -743,7 +743,7 @@ int main(int argc, char** argv) {
         ->delimiter(',');
 
     std::string explain_scene, explain_pixel_text;
-    bool explain_json = false;
+    bool explain_json = false, explain_summary = false;
     int explain_threads = 0;
     CLI::App* explain_cmd = app.add_subcommand(
         "explain", "Print every term of one pixel's equation, as the render computes it (docs/layers.md)");
@@ -751,7 +751,12 @@ int main(int argc, char** argv) {
     explain_cmd
         ->add_option("--pixel", explain_pixel_text, "The pixel: X,Y (column, row from the top-left corner, 0-based)")
         ->required();
-    explain_cmd->add_flag("--json", explain_json, "Print JSON (docs/explain.schema.json) instead of text");
+    CLI::Option* explain_json_flag =
+        explain_cmd->add_flag("--json", explain_json, "Print JSON (docs/explain.schema.json) instead of text");
+    explain_cmd
+        ->add_flag("--summary", explain_summary,
+                   "Print the pixel in a dozen lines: its first hit, each term averaged over the samples, the pixel")
+        ->excludes(explain_json_flag);
     explain_cmd->add_option("-t,--threads", explain_threads, "Threads for building the BVH (default: all cores)")
         ->check(CLI::Range(0, 4096));
 
@@ -865,7 +870,8 @@ int main(int argc, char** argv) {
     }
 
     if ((*render_cmd || *check_cmd || *explain_cmd) && !embree_isa_usable()) return exit_bad_input;
-    if (*explain_cmd) return run_explain(explain_scene, explain_pixel_text, explain_json, explain_threads);
+    if (*explain_cmd)
+        return run_explain(explain_scene, explain_pixel_text, explain_json, explain_summary, explain_threads);
     if (*render_cmd) {
         const int code = run_render(render_args);
         // Every rank finalizes only after success: a rank that failed exits without, so that

@@ -4,7 +4,8 @@
 --intersection replace the scene's settings as if the file said them, --crop renders a window
 whose pixels are the whole render's bit for bit, `-` reads the scene from standard input, and
 every mistake is a usage error (exit 2) before any work, leaving an existing output as it was.
-Also: the nearest-name suggestions, and the warning for pixels past the largest float.
+Also: the nearest-name suggestions, `explain --summary`, and the warning for pixels past the
+largest float.
 
 Each expectation is derived from the rule, not from a render of this code: the size from the
 aspect-ratio rule, the crop from the whole render's own pixels, stdin from the file's render,
@@ -171,6 +172,29 @@ result = run(["render", base, "-o", "x.exr", "--layers", "difuse"], expect=2)
 check(b"did you mean 'diffuse'" in result.stderr, f"--layers difuse: {result.stderr!r}")
 result = run(["\x1b]0;title\x07"], expect=2)
 check(b"\x1b" not in result.stderr, f"an escape sequence reached the terminal: {result.stderr!r}")
+
+# --- explain --summary --------------------------------------------------------------------------------
+# A dozen lines whose six colour terms add up to the pixel, and whose float pixel is the EXR's.
+import re
+result = run(["explain", base, "--pixel", "48,50", "--summary"])
+lines = result.stdout.decode().splitlines()
+check(len(lines) <= 16, f"explain --summary printed {len(lines)} lines")
+numbers = r"\(([-+0-9.e]+), ([-+0-9.e]+), ([-+0-9.e]+)\)"
+terms = {}
+for line in lines:
+    match = re.match(r"  (\w+) +" + numbers, line)
+    if match:
+        terms[match.group(1)] = np.array([float(match.group(k)) for k in (2, 3, 4)])
+colour_terms = ["ambient", "diffuse", "specular", "mirror", "transmission", "background"]
+check(all(name in terms for name in colour_terms + ["pixel"]), f"explain --summary lacks a term: {lines}")
+if all(name in terms for name in colour_terms + ["pixel"]):
+    total = sum(terms[name] for name in colour_terms)
+    check(np.allclose(total, terms["pixel"], rtol=1e-12, atol=1e-15), f"terms {total} do not add to {terms['pixel']}")
+exr_match = re.search(r"the EXR's R, G, B: " + numbers, result.stdout.decode())
+check(exr_match is not None and np.array_equal(
+    np.array([float(exr_match.group(k)) for k in (1, 2, 3)], np.float32), read_exr("file.exr")[50, 48]),
+    f"explain --summary: the EXR value is not the render's: {exr_match and exr_match.group(0)}")
+run(["explain", base, "--pixel", "48,50", "--summary", "--json"], expect=2)
 
 # --- radiance past the largest float -----------------------------------------------------------------
 # A colour of 1e258 (a fuzzer's find): the pixels are +inf in the EXR, and the render says so.
