@@ -369,9 +369,9 @@ TEST(ObjWild, MessagesEscapeBytesThatAreNotText) {
     directory.write("m.mtl", "newmtl Gr\xC3\xBCn\n");  // UTF-8 "Grün": printed as it is
     const std::string path =
         directory.write("m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl Gr\xFCn\nf 1 2 3\n");
-    const auto error = test::input_error_from([&] { (void)load_obj_mesh(path, {}); });
-    ASSERT_TRUE(error);
-    EXPECT_THAT(std::string(error->what()),
+    const MeshData mesh = load_obj_mesh(path, {});
+    ASSERT_EQ(mesh.warnings.size(), 1u);
+    EXPECT_THAT(mesh.warnings[0],
                 HasSubstr(path + ":5:8: material 'Gr\\xFCn' is not defined in 'm.mtl' (did you mean 'Gr\xC3\xBCn'?)"));
 }
 
@@ -429,42 +429,57 @@ TEST(ObjWild, MtllibOfOneNameWithSpaces) {
     EXPECT_EQ(mesh.triangle_material, (std::vector<int32_t>{0}));
 }
 
-TEST(ObjWild, UndefinedMaterialSaysWhereAndWhy) {
+// A usemtl that no MTL file defines is drawn, as assimp and Blender draw it, in the default
+// material, with a warning that says where and why.
+TEST(ObjWild, UndefinedMaterialIsDrawnInTheDefaultWithAWarningSayingWhereAndWhy) {
     const test::ScratchDirectory directory;
     directory.write("known.mtl", "newmtl red\nKd 1 0 0\n");
-    const std::string undefined =
-        directory.write("u.obj", std::string("mtllib known.mtl\n") + triangle_obj_body + "usemtl blue\nf 1 2 3\n");
-    auto error = test::input_error_from([&] { (void)load_obj_mesh(undefined, {}); });
-    ASSERT_TRUE(error);
-    EXPECT_THAT(std::string(error->what()),
-                HasSubstr(undefined + ":6:8: material 'blue' is not defined in 'known.mtl'"));
-    EXPECT_THAT(std::string(error->what()), Not(HasSubstr("usemtl)")));
+    const std::string undefined = directory.write(
+        "u.obj", std::string("mtllib known.mtl\n") + triangle_obj_body + "usemtl blue\nf 1 2 3\nusemtl red\nf 2 4 3\n");
+    MeshData mesh = load_obj_mesh(undefined, {});
+    ASSERT_EQ(mesh.warnings.size(), 1u);
+    EXPECT_THAT(mesh.warnings[0], HasSubstr(undefined + ":6:8: material 'blue' is not defined in 'known.mtl'"));
+    EXPECT_THAT(mesh.warnings[0], HasSubstr("(1 triangle); they get the default material (kd 0.6 grey"));
+    ASSERT_EQ(mesh.materials.size(), 2u);  // red, then the default
+    EXPECT_EQ(mesh.triangle_material, (std::vector<int32_t>{1, 0}));
+    EXPECT_EQ(mesh.materials[1].kd.value, Color(0.6));
 
     const std::string missing = directory.write(
         "m.obj", std::string("mtllib known.mtl gone.mtl\n") + triangle_obj_body + "usemtl blue\nf 1 2 3\n");
-    error = test::input_error_from([&] { (void)load_obj_mesh(missing, {}); });
-    ASSERT_TRUE(error);
-    EXPECT_THAT(std::string(error->what()),
-                HasSubstr(missing +
-                          ":6:8: material 'blue' is not defined in 'known.mtl': the MTL file 'gone.mtl' "
-                          "(mtllib at " +
-                          missing + ":1:18) was not found"));
+    mesh = load_obj_mesh(missing, {});
+    ASSERT_EQ(mesh.warnings.size(), 1u);
+    EXPECT_THAT(mesh.warnings[0], HasSubstr(missing +
+                                            ":6:8: material 'blue' is not defined in 'known.mtl': the MTL file "
+                                            "'gone.mtl' (mtllib at " +
+                                            missing + ":1:18) was not found"));
 
-    // The object's own material makes the MTL files unneeded: nothing to refuse.
-    EXPECT_NO_THROW((void)load_obj_mesh(missing, {}, 0, false));
+    // The object's own material makes the MTL files unneeded: nothing to say.
+    EXPECT_TRUE(load_obj_mesh(missing, {}, 0, false).warnings.empty());
 }
 
-TEST(ObjWild, BrokenMtlIsNoErrorWhenTheSceneGivesTheMaterial) {
+// A statement before any newmtl belongs to no material: left out with a warning. What cannot be
+// read at all (a colour that is not a number) is still refused, with its place.
+TEST(ObjWild, MtlStatementBeforeAnyNewmtlIsLeftOutWithAWarning) {
     const test::ScratchDirectory directory;
-    directory.write("broken.mtl", "Kd 1 0 0\nnewmtl x\nKd red\n");
+    directory.write("early.mtl", "Kd 1 0 0\nnewmtl x\nKd 0 0 1\n");
     const std::string path =
+        directory.write("e.obj", std::string("mtllib early.mtl\n") + triangle_obj_body + "usemtl x\nf 1 2 3\n");
+    const MeshData mesh = load_obj_mesh(path, {});
+    ASSERT_EQ(mesh.warnings.size(), 1u);
+    EXPECT_THAT(mesh.warnings[0], HasSubstr("early.mtl:1:1: Kd before any newmtl belongs to no material"));
+    ASSERT_EQ(mesh.materials.size(), 1u);
+    EXPECT_EQ(mesh.materials[0].kd.value, (Color{0, 0, 1}));
+
+    directory.write("broken.mtl", "newmtl x\nKd red\n");
+    const std::string broken =
         directory.write("b.obj", std::string("mtllib broken.mtl\n") + triangle_obj_body + "usemtl x\nf 1 2 3\n");
-    const auto error = test::input_error_from([&] { (void)load_obj_mesh(path, {}); });
+    const auto error = test::input_error_from([&] { (void)load_obj_mesh(broken, {}); });
     ASSERT_TRUE(error);
-    EXPECT_THAT(std::string(error->what()), HasSubstr("broken.mtl:1:1: Kd before any newmtl"));
-    const MeshData mesh = load_obj_mesh(path, {}, 0, false);
-    EXPECT_TRUE(mesh.materials.empty());
-    EXPECT_EQ(mesh.triangle_material, (std::vector<int32_t>{-1}));
+    EXPECT_THAT(std::string(error->what()), HasSubstr("broken.mtl:2:4: expected a colour"));
+    // The scene's own material makes the MTL file unneeded: it is not read.
+    const MeshData own = load_obj_mesh(broken, {}, 0, false);
+    EXPECT_TRUE(own.materials.empty());
+    EXPECT_EQ(own.triangle_material, (std::vector<int32_t>{-1}));
 }
 
 TEST(ObjWild, FacesWithoutMaterialGetTheDefaultOneAndAWarning) {

@@ -242,9 +242,9 @@ public:
         fail(std::string("expected ") + what + ", got " + quote_name(t));
     }
 
-    [[noreturn]] void fail(const std::string& message) const {
-        throw InputError({m_path, m_line_number, int(m_token_start) + 1}, message);
-    }
+    [[noreturn]] void fail(const std::string& message) const { throw InputError(where(), message); }
+    /// The place of the last token, or rest().
+    SourceLocation where() const { return {m_path, m_line_number, int(m_token_start) + 1}; }
 
     /// The column (from 1) where the last token, or rest(), began.
     size_t token_column() const { return m_token_start + 1; }
@@ -282,8 +282,10 @@ Color read_color(LineReader& line, const char* what) {
     return c;
 }
 
+/// Reads an MTL file's materials. A statement before any `newmtl` belongs to no material: it is
+/// left out with a warning, as other readers forgive it.
 void read_mtl(const std::string& path, std::vector<MaterialDescription>& materials,
-              std::unordered_map<std::string, int32_t>& by_name) {
+              std::unordered_map<std::string, int32_t>& by_name, std::vector<std::string>& warnings) {
     const std::string file_text = read_text_file(path, limits::max_mesh_file_bytes, "MTL file");
     const std::string_view text = without_byte_order_mark(file_text, path);
     if (!is_plain_ascii(text)) check_text_bytes(text, path);
@@ -304,7 +306,11 @@ void read_mtl(const std::string& path, std::vector<MaterialDescription>& materia
         const bool known =
             keyword == "Ka" || keyword == "Kd" || keyword == "Ks" || keyword == "Ns" || keyword == "illum";
         if (!known) return;
-        if (!current) line.fail(std::string(keyword) + " before any newmtl");
+        if (!current) {
+            warnings.push_back(line.where().str() + ": " + std::string(keyword) +
+                               " before any newmtl belongs to no material; it is left out");
+            return;
+        }
         if (keyword == "Ka")
             current->ka.value = read_color(line, "a colour");
         else if (keyword == "Kd")
@@ -761,7 +767,7 @@ void resolve_materials(const std::string& path, ObjContents& contents) {
             missing.push_back(&mtl);
             continue;
         }
-        read_mtl(mtl.path, mesh.materials, by_name);
+        read_mtl(mtl.path, mesh.materials, by_name, mesh.warnings);
         read_names += (read_names.empty() ? "" : ", ") + quote_name(mtl.name);
     }
     std::vector<std::string> defined;
@@ -799,7 +805,8 @@ void resolve_materials(const std::string& path, ObjContents& contents) {
             if (suggestion.size() > head.size() + 3)
                 message += " (did you mean " +
                            quote_name(suggestion.substr(head.size(), suggestion.size() - head.size() - 3)) + "?)";
-            throw InputError(where, message);
+            // Drawn, as other readers draw it, in the default material, with a warning.
+            why_default[k] = where.str() + ": " + message;
         }
     }
     size_t default_triangles = 0;
