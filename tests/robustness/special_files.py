@@ -46,7 +46,9 @@ def main():
                 f.write(text)
             return path
 
-        # (what, scene path, path the message must name)
+        # (what, scene path, path the message must name). An MTL file that is not a regular file is
+        # not read: its materials are undefined, which is a warning (the faces get the default
+        # material), so that case renders; every other case is refused (exit 2).
         cases = [(f"scene file {dev}", dev, dev) for dev in ("/dev/zero", "/dev/urandom", "/dev/null")]
         cases += [
             ("scene file: a FIFO", fifo, fifo),
@@ -69,6 +71,26 @@ def main():
         os.symlink("/dev/zero", os.path.join(d, "zero-link.yaml"))
         write("with_mtl.obj", "mtllib fifo-table.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n")
 
+        # The OpenColorIO config: a FIFO given with --ocio-config or $OCIO is refused before OCIO
+        # opens it (it would wait for a writer forever).
+        ocio_scene = write("plain.yaml", SCENE_HEAD + "objects:\n  - { type: sphere, center: [0, 0, 0], radius: 1, "
+                                                      "material: { kd: 1 } }\n")
+        for how, args, env in [("--ocio-config", ["--ocio-config", fifo], {}),
+                               ("$OCIO", [], {"OCIO": fifo})]:
+            for command in (["render", ocio_scene, "-o", os.path.join(d, "ocio.png"), *args],
+                            ["colour", "--list", *args]):
+                try:
+                    r = subprocess.run([whitted, *command], stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                                       timeout=TIMEOUT, cwd=d, env={**os.environ, **env})
+                except subprocess.TimeoutExpired:
+                    failures.append(f"{command[0]}, OCIO config a FIFO by {how}: still running after {TIMEOUT} s")
+                    continue
+                ok = r.returncode == 2 and "not a regular file" in r.stderr and fifo in r.stderr
+                print(f"{'ok' if ok else 'FAIL'}: {command[0]}, OCIO config a FIFO by {how}: exit {r.returncode}: "
+                      f"{r.stderr.strip()}")
+                if not ok:
+                    failures.append(f"{command[0]}, OCIO config a FIFO by {how}: exit {r.returncode}, {r.stderr!r}")
+
         for what, scene, named in cases:
             for command in ("render", "convert", "explain"):
                 output = os.path.join(d, "out." + ("pov" if command == "convert" else "png"))
@@ -84,15 +106,22 @@ def main():
                     continue
                 seconds = time.monotonic() - start
                 problems = []
-                if r.returncode != 2:
-                    problems.append(f"exit {r.returncode}, expected 2")
+                warned = what.startswith("MTL file")
+                if r.returncode != (0 if warned else 2):
+                    problems.append(f"exit {r.returncode}, expected {0 if warned else 2}")
                 if "not a regular file" not in r.stderr:
                     problems.append("no 'not a regular file' in the message")
                 if named not in r.stderr:
                     problems.append(f"the message does not name {named}")
+                if warned and "whitted: warning:" not in r.stderr:
+                    problems.append("no warning")
                 if os.path.exists(output):
-                    problems.append(f"{os.path.basename(output)} was written")
+                    if not warned:
+                        problems.append(f"{os.path.basename(output)} was written")
                     os.unlink(output)
+                for extra in [output[:-4] + ".ini"] if command == "convert" else []:
+                    if os.path.exists(extra):
+                        os.unlink(extra)
                 status = "FAIL" if problems else "ok"
                 print(f"{status}: {command}, {what}: exit {r.returncode} in {seconds:.2f} s: {r.stderr.strip()}")
                 if problems:

@@ -136,6 +136,25 @@ TEST(CourseXml, MistakesNameLineAndColumn) {
               std::string::npos);
 }
 
+// Elements nested past 512 levels are refused where the 513th opens, however deep the file goes:
+// 300,000 levels once overflowed the stack while the tree was freed during the error's unwinding.
+TEST(CourseXml, DeepNestingIsRefusedWhereItPassesTheLimit) {
+    for (const size_t levels : {size_t(513), size_t(300000)}) {
+        std::string text = "<scene>";
+        for (size_t i = 1; i < levels; ++i) text += "<surface>";
+        for (size_t i = 1; i < levels; ++i) text += "</surface>";
+        text += "</scene>";
+        try {
+            parse_course_xml_text(text, "deep.xml");
+            ADD_FAILURE() << levels << " levels: no error";
+        } catch (const InputError& e) {
+            EXPECT_EQ(e.message(), "elements nested more than 512 levels deep") << levels;
+            // The 513th element begins after "<scene>" and 511 "<surface>"s.
+            EXPECT_EQ(e.where().str(), "deep.xml:1:" + std::to_string(7 + 511 * 9 + 1)) << levels;
+        }
+    }
+}
+
 TEST(Shading, SchlickFresnelClosedForm) {
     const double r0 = 0.04;
     EXPECT_DOUBLE_EQ(LectureShading::schlick_fresnel(r0, 1.0), 0.04);

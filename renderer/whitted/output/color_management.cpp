@@ -142,17 +142,25 @@ std::vector<std::string> views_of(const OCIO::ConstConfigRcPtr& config, const st
 /// The config `config_path` names, else $OCIO's, else the built-in one; `source` says which.
 OCIO::ConstConfigRcPtr load_config(const std::string& config_path, std::string& source) {
     const char* env = std::getenv("OCIO");
+    // OCIO reads a directory or a file that is no config as an empty YAML document and then says
+    // little, and it would wait forever on a FIFO (or read /dev/zero without end): only a regular
+    // file (or a link to one) is handed to it.
+    const auto check_file = [](const std::string& path) {
+        std::error_code error;
+        const auto status = std::filesystem::status(path, error);
+        if (!std::filesystem::exists(status)) throw std::runtime_error("no such file");
+        if (std::filesystem::is_directory(status)) throw std::runtime_error("it is a directory");
+        if (!std::filesystem::is_regular_file(status))
+            throw std::runtime_error("it is not a regular file (a FIFO, socket or device)");
+    };
     try {
         if (!config_path.empty()) {
-            // OCIO reads a directory or a file that is no config as an empty YAML document and
-            // then says little; these two are worth naming.
-            std::error_code error;
-            if (!std::filesystem::exists(config_path, error)) throw std::runtime_error("no such file");
-            if (std::filesystem::is_directory(config_path, error)) throw std::runtime_error("it is a directory");
+            check_file(config_path);
             source = config_path;
             return OCIO::Config::CreateFromFile(config_path.c_str());
         }
         if (env && *env) {
+            check_file(env);
             source = std::string("$OCIO=") + env;
             return OCIO::Config::CreateFromFile(env);
         }

@@ -15,8 +15,10 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 
 namespace whitted {
 namespace {
@@ -59,11 +61,17 @@ std::string canonical_element_name(const char* name) {
     return std::string(given);
 }
 
+/// Elements nested deeper than this are refused while reading, as YAML values are
+/// (yaml_tree.h): a course scene nests a few levels (groups at most limits::max_nesting), and a
+/// tree of hundreds of thousands of levels overflowed the stack when it was freed.
+constexpr size_t max_xml_depth = 512;
+
 struct TreeBuilder {
     XML_Parser parser = nullptr;
     std::string file;
     std::unique_ptr<Element> root;
     std::vector<Element*> open;
+    std::optional<InputError> stopped;  ///< why the parser was stopped, if it was
 
     SourceLocation here() const {
         return {file, int(XML_GetCurrentLineNumber(parser)), int(XML_GetCurrentColumnNumber(parser)) + 1};
@@ -71,6 +79,12 @@ struct TreeBuilder {
 
     static void start(void* data, const XML_Char* name, const XML_Char** attributes) {
         auto* self = static_cast<TreeBuilder*>(data);
+        if (self->open.size() >= max_xml_depth) {
+            self->stopped.emplace(self->here(),
+                                  "elements nested more than " + std::to_string(max_xml_depth) + " levels deep");
+            XML_StopParser(self->parser, XML_FALSE);
+            return;
+        }
         auto element = std::make_unique<Element>();
         element->name = canonical_element_name(name);
         element->where = self->here();
@@ -82,7 +96,10 @@ struct TreeBuilder {
             self->open.back()->children.push_back(std::move(element));
         self->open.push_back(raw);
     }
-    static void end(void* data, const XML_Char*) { static_cast<TreeBuilder*>(data)->open.pop_back(); }
+    static void end(void* data, const XML_Char*) {
+        auto* self = static_cast<TreeBuilder*>(data);
+        if (!self->open.empty()) self->open.pop_back();
+    }
     static void text(void* data, const XML_Char* s, int length) {
         auto* self = static_cast<TreeBuilder*>(data);
         if (self->open.empty()) return;
@@ -109,10 +126,12 @@ std::unique_ptr<Element> parse_xml(const std::string& text, const std::string& p
     XML_SetElementHandler(parser.get(), TreeBuilder::start, TreeBuilder::end);
     XML_SetCharacterDataHandler(parser.get(), TreeBuilder::text);
     if (text.size() > size_t(std::numeric_limits<int>::max())) throw InputError({path}, "the scene file is too large");
-    if (XML_Parse(parser.get(), text.data(), int(text.size()), XML_TRUE) == XML_STATUS_ERROR)
+    if (XML_Parse(parser.get(), text.data(), int(text.size()), XML_TRUE) == XML_STATUS_ERROR) {
+        if (builder.stopped) throw *builder.stopped;
         throw InputError(
             {path, int(XML_GetCurrentLineNumber(parser.get())), int(XML_GetCurrentColumnNumber(parser.get())) + 1},
             std::string("XML syntax error: ") + XML_ErrorString(XML_GetErrorCode(parser.get())));
+    }
     if (!builder.root) throw InputError({path, 1, 1}, "the file has no XML element");
     return std::move(builder.root);
 }
