@@ -6,6 +6,7 @@
 #include "whitted/scene/description.h"
 #include "whitted/scene/scene.h"
 #include "whitted/scene/source_location.h"
+#include "whitted/scene/text_checks.h"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -50,7 +51,7 @@ nlohmann::json jray(const Ray& r) {
 std::string object_label(const Scene& scene, uint32_t object) {
     if (object == 0 || object > scene.objects.size()) return fmt::format("object {}", object);
     const SceneObject& o = scene.objects[object - 1];
-    return fmt::format("object {} ({}, {})", object, to_string(o.type), o.where.str());
+    return fmt::format("object {} ({}, {})", object, to_string(o.type), printable(o.where.str(), 4096));
 }
 nlohmann::json jobject(const Scene& scene, uint32_t object) {
     nlohmann::json j = {{"id", object}};
@@ -62,7 +63,7 @@ nlohmann::json jobject(const Scene& scene, uint32_t object) {
 }
 std::string material_label(const Scene& scene, uint32_t material) {
     const std::string& name = scene.material_names[material];
-    return fmt::format("material {} ({})", material + 1, name.empty() ? "inline" : "'" + name + "'");
+    return fmt::format("material {} ({})", material + 1, name.empty() ? "inline" : "'" + printable(name) + "'");
 }
 
 /// The specular lobe's pieces for the printout: h and n·h (Blinn) or r_v and r_v·l (Phong).
@@ -95,8 +96,8 @@ std::string light_label(const Scene& scene, size_t index) {
 
 void print_text(const Scene& scene, const std::string& path, const PixelExplanation& e) {
     const int n = scene.samples;
-    std::printf("pixel (%d, %d) of %s: %dx%d, %d sample(s) per pixel, max depth %d\n", e.x, e.y, path.c_str(),
-                scene.width, scene.height, n * n, scene.max_depth);
+    std::printf("pixel (%d, %d) of %s: %dx%d, %d sample(s) per pixel, max depth %d\n", e.x, e.y,
+                printable(path, 4096).c_str(), scene.width, scene.height, n * n, scene.max_depth);
     std::printf("L = ka*Ia + sum_i [kd*I_i*max(0,n.l_i) + ks*I_i*max(0,n.h_i)^p] + km*L(r)\n");
     for (const ExplainedSample& sample : e.samples) {
         std::printf("\nsample %d (column %d, row %d of the %dx%d grid)\n", sample.sample, sample.sample % n,
@@ -202,8 +203,8 @@ void print_text(const Scene& scene, const std::string& path, const PixelExplanat
 /// terms averaged over the samples (the render layers of the pixel), and the pixel itself.
 void print_summary(const Scene& scene, const std::string& path, const PixelExplanation& e) {
     const int n = scene.samples;
-    std::printf("pixel (%d, %d) of %s: %dx%d, %d sample(s) per pixel, max depth %d\n", e.x, e.y, path.c_str(),
-                scene.width, scene.height, n * n, scene.max_depth);
+    std::printf("pixel (%d, %d) of %s: %dx%d, %d sample(s) per pixel, max depth %d\n", e.x, e.y,
+                printable(path, 4096).c_str(), scene.width, scene.height, n * n, scene.max_depth);
     const ExplainedSegment& first = e.samples.front().segments.front();
     if (first.hit)
         std::printf("  first hit (sample 0): %s, %s, at t = %s\n", object_label(scene, first.surface.object).c_str(),
@@ -355,7 +356,11 @@ int run_explain(const std::string& scene_path, const std::string& pixel, bool js
         const Accelerator accelerator(scene, threads);
         const PixelExplanation explanation = explain_pixel(scene, accelerator, x, y);
         if (json)
-            std::printf("%s\n", to_json(scene, scene_path, explanation).dump(2).c_str());
+            // Names may be Latin-1 (MTL files): bytes that are not UTF-8 are written as U+FFFD, so
+            // that the output is JSON whatever the scene holds.
+            std::printf("%s\n", to_json(scene, scene_path, explanation)
+                                    .dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
+                                    .c_str());
         else if (summary)
             print_summary(scene, scene_path, explanation);
         else

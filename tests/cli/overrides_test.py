@@ -196,6 +196,32 @@ check(exr_match is not None and np.array_equal(
     f"explain --summary: the EXR value is not the render's: {exr_match and exr_match.group(0)}")
 run(["explain", base, "--pixel", "48,50", "--summary", "--json"], expect=2)
 
+# Names reach the terminal escaped, and --json is JSON whatever bytes a name holds (an MTL
+# material name may be Latin-1).
+with open(os.path.join(work, "escape.yaml"), "w") as f:
+    f.write("version: 1\ncamera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\nimage: {width: 8, height: 8}\n"
+            "lights: [{type: point, position: [0, 0, 5]}]\nmaterials:\n  \"\\e]0;title\\a\": {kd: 1}\n"
+            "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, material: \"\\e]0;title\\a\"}\n")
+for extra in ([], ["--summary"]):
+    result = run(["explain", "escape.yaml", "--pixel", "4,4", *extra])
+    check(b"\\x1b]0;title\\x07" in result.stdout and b"\x1b" not in result.stdout and b"\x07" not in result.stdout,
+          f"explain {extra}: a name's control characters reached the terminal: {result.stdout[:300]!r}")
+with open(os.path.join(work, "latin1.mtl"), "wb") as f:
+    f.write(b"newmtl Gr\xfcn\nKd 1 1 1\n")
+with open(os.path.join(work, "latin1.obj"), "wb") as f:
+    f.write(b"mtllib latin1.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl Gr\xfcn\nf 1 2 3\n")
+with open(os.path.join(work, "latin1.yaml"), "w") as f:
+    f.write("version: 1\ncamera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\nimage: {width: 8, height: 8}\n"
+            "lights: [{type: point, position: [0, 0, 5]}]\nobjects:\n  - {type: mesh, file: latin1.obj}\n")
+result = run(["explain", "latin1.yaml", "--pixel", "4,4", "--json"])
+try:
+    import json
+    explained = json.loads(result.stdout)
+    check("Gr\ufffdn" in json.dumps(explained, ensure_ascii=False),
+          "explain --json: the Latin-1 name is not written as U+FFFD")
+except ValueError as e:
+    failures.append(f"explain --json with a Latin-1 material name is not JSON: {e}")
+
 # --- radiance past the largest float -----------------------------------------------------------------
 # A colour of 1e258 (a fuzzer's find): the pixels are +inf in the EXR, and the render says so.
 overflow = os.path.join(source, "tests", "fuzz", "regressions", "fuzz_render", "colour_1e258_overflows_the_pixel.nff")

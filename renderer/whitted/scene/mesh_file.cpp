@@ -638,7 +638,7 @@ private:
                 int64_t index = 0;
                 const auto [stop, ec] = std::from_chars(part.data(), part.data() + part.size(), index);
                 if (ec != std::errc() || stop != part.data() + part.size())
-                    line.fail(std::string("expected a ") + what + " index, got '" + std::string(part) + "'");
+                    line.fail(std::string("expected a ") + what + " index, got " + quote_name(part));
                 if (index == 0) line.fail(std::string(what) + " index 0: OBJ indices start at 1");
                 const int64_t written = index;
                 if (!resolve(index, count))
