@@ -14,8 +14,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <new>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -264,7 +266,27 @@ struct SceneBuilder::Impl {
 
     SourceLocation next() { return builder_where(++calls); }
 
+    /// The file reader refuses a number that is not finite where it reads it (`must be a finite
+    /// number`); the builder does the same for the first such argument, and build() reports it.
+    std::optional<InputError> first_error;
+    void require_finite(const SourceLocation& where, const std::string& what, std::initializer_list<double> values) {
+        if (first_error) return;
+        for (const double value : values)
+            if (!std::isfinite(value)) {
+                first_error.emplace(where, what + ": must be a finite number, got " + std::to_string(value));
+                return;
+            }
+    }
+    void require_finite(const SourceLocation& where, const std::string& what, const Vec3& v) {
+        require_finite(where, what, {v.x, v.y, v.z});
+    }
+
     ObjectDescription& add_object(ObjectType type, const SourceLocation& where, const api::Material& m) {
+        require_finite(where, "material.ka", m.ka);
+        require_finite(where, "material.kd", m.kd);
+        require_finite(where, "material.ks", m.ks);
+        require_finite(where, "material.p", {m.p});
+        require_finite(where, "material.km", m.km);
         ObjectDescription& object = description.objects.emplace_back();
         object.where = where;
         object.type = type;
@@ -303,6 +325,7 @@ SceneBuilder& SceneBuilder::image(int width, int height, int samples) {
 
 SceneBuilder& SceneBuilder::background(Vec3 color) {
     m_impl->description.image.background = given(vec(color), m_impl->next());
+    m_impl->require_finite(m_impl->description.image.background.where, "image.background", color);
     return *this;
 }
 
@@ -314,12 +337,17 @@ SceneBuilder& SceneBuilder::camera(Vec3 eye, Vec3 look_at, Vec3 up, double fov_d
     camera.look_at = given(vec(look_at), where);
     camera.up = given(vec(up), where);
     camera.fov = given(fov_degrees, where);
+    m_impl->require_finite(where, "camera.eye", eye);
+    m_impl->require_finite(where, "camera.look_at", look_at);
+    m_impl->require_finite(where, "camera.up", up);
+    m_impl->require_finite(where, "camera.fov", {fov_degrees});
     m_impl->camera_call = m_impl->calls;
     return *this;
 }
 
 SceneBuilder& SceneBuilder::ambient(Vec3 intensity) {
     m_impl->description.ambient = given(vec(intensity), m_impl->next());
+    m_impl->require_finite(m_impl->description.ambient.where, "ambient", intensity);
     return *this;
 }
 
@@ -335,6 +363,8 @@ SceneBuilder& SceneBuilder::point_light(Vec3 position, Vec3 intensity) {
     light.type = LightType::point;
     light.position = given(vec(position), where);
     light.intensity = given(vec(intensity), where);
+    m_impl->require_finite(where, "point_light.position", position);
+    m_impl->require_finite(where, "point_light.intensity", intensity);
     return *this;
 }
 
@@ -345,6 +375,8 @@ SceneBuilder& SceneBuilder::directional_light(Vec3 direction, Vec3 intensity) {
     light.type = LightType::directional;
     light.direction = given(vec(direction), where);
     light.intensity = given(vec(intensity), where);
+    m_impl->require_finite(where, "directional_light.direction", direction);
+    m_impl->require_finite(where, "directional_light.intensity", intensity);
     return *this;
 }
 
@@ -353,6 +385,8 @@ SceneBuilder& SceneBuilder::sphere(Vec3 center, double radius, const Material& m
     ObjectDescription& object = m_impl->add_object(ObjectType::sphere, where, material);
     object.center = given(vec(center), where);
     object.radius = given(radius, where);
+    m_impl->require_finite(where, "sphere.center", center);
+    m_impl->require_finite(where, "sphere.radius", {radius});
     return *this;
 }
 
@@ -361,6 +395,8 @@ SceneBuilder& SceneBuilder::plane(Vec3 point, Vec3 normal, const Material& mater
     ObjectDescription& object = m_impl->add_object(ObjectType::plane, where, material);
     object.point = given(vec(point), where);
     object.normal = given(vec(normal), where);
+    m_impl->require_finite(where, "plane.point", point);
+    m_impl->require_finite(where, "plane.normal", normal);
     return *this;
 }
 
@@ -369,6 +405,8 @@ SceneBuilder& SceneBuilder::box(Vec3 min, Vec3 max, const Material& material) {
     ObjectDescription& object = m_impl->add_object(ObjectType::box, where, material);
     object.min = given(vec(min), where);
     object.max = given(vec(max), where);
+    m_impl->require_finite(where, "box.min", min);
+    m_impl->require_finite(where, "box.max", max);
     return *this;
 }
 
@@ -377,6 +415,7 @@ SceneBuilder& SceneBuilder::triangle(Vec3 a, Vec3 b, Vec3 c, const Material& mat
     ObjectDescription& object = m_impl->add_object(ObjectType::triangle, where, material);
     object.vertices_where = where;
     object.vertices = {vec(a), vec(b), vec(c)};
+    m_impl->require_finite(where, "triangle.vertices", {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z});
     return *this;
 }
 
@@ -387,6 +426,7 @@ Expected<Scene> SceneBuilder::build() const {
         return input_error(InputError({file, 0, 0}, "no image(width, height) given: the scene needs its size"));
     if (!impl.camera_call)
         return input_error(InputError({file, 0, 0}, "no camera(eye, look_at) given: the scene needs a camera"));
+    if (impl.first_error) return input_error(*impl.first_error);
     return load("<SceneBuilder>", [&](Scene::Impl& built) {
         built.description = impl.description;
         built.scene = validate_scene(built.description);

@@ -152,6 +152,9 @@ private:
 };
 
 void install_signal_handlers() {
+    // Past a file size limit (ulimit -f) a write fails with EFBIG, which the writers report and
+    // clean up after, instead of SIGXFSZ killing the process with its temporary file left.
+    std::signal(SIGXFSZ, SIG_IGN);
     struct sigaction action {};
     action.sa_handler = on_signal;
     sigemptyset(&action.sa_mask);

@@ -163,8 +163,21 @@ api::Vec3 vec(const std::array<double, 3>& v) {
 
 api::Material material(const py::dict& m) {
     api::Material out;
+    // As in a scene file: a colour is three numbers, or one number for a grey.
     auto get3 = [&](const char* key, api::Vec3& into) {
-        if (m.contains(key)) into = vec(m[key].cast<std::array<double, 3>>());
+        if (!m.contains(key)) return;
+        const py::handle value = m[key];
+        try {
+            if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)) {
+                const double grey = value.cast<double>();
+                into = {grey, grey, grey};
+            } else {
+                into = vec(value.cast<std::array<double, 3>>());
+            }
+        } catch (const py::cast_error&) {
+            throw py::value_error(std::string("material: ") + key + " must be a number or three numbers, not " +
+                                  py::repr(value).cast<std::string>());
+        }
     };
     for (const auto& item : m) {
         const auto key = item.first.cast<std::string>();
@@ -175,7 +188,13 @@ api::Material material(const py::dict& m) {
     get3("kd", out.kd);
     get3("ks", out.ks);
     get3("km", out.km);
-    if (m.contains("p")) out.p = m["p"].cast<double>();
+    if (m.contains("p")) {
+        try {
+            out.p = m["p"].cast<double>();
+        } catch (const py::cast_error&) {
+            throw py::value_error("material: p must be a number, not " + py::repr(m["p"]).cast<std::string>());
+        }
+    }
     return out;
 }
 

@@ -233,6 +233,21 @@ check(count > 0 and f"warning: {count} pixel value(s) exceed the largest float".
 result = run(["render", base, "-q", "-o", "finite.exr"])
 check(b"warning" not in result.stderr, f"a finite render warned: {result.stderr!r}")
 
+# --- past a file size limit (ulimit -f) -------------------------------------------------------------
+# The write fails with a message (exit 1) instead of SIGXFSZ killing the process; the previous
+# output stays and no temporary file is left.
+import resource
+with open(os.path.join(work, "limited.exr"), "wb") as f:
+    f.write(b"previous image")
+before = set(os.listdir(work))
+limited = subprocess.run([whitted, "render", base, "-q", "-o", "limited.exr"], capture_output=True, cwd=work,
+                         preexec_fn=lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (4096, 4096)))
+check(limited.returncode == 1 and b"File too large" in limited.stderr,
+      f"ulimit -f: exit {limited.returncode}, {limited.stderr!r}")
+with open(os.path.join(work, "limited.exr"), "rb") as f:
+    check(f.read() == b"previous image", "ulimit -f: the previous output changed")
+check(set(os.listdir(work)) == before, f"ulimit -f: files left: {set(os.listdir(work)) - before}")
+
 if failures:
     print("FAIL:\n" + "\n".join(failures))
     sys.exit(1)

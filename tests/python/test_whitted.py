@@ -312,3 +312,40 @@ def test_a_crop_outside_the_image_is_an_error(crop):
 def test_a_crop_that_is_not_four_whole_numbers_is_a_value_error(crop):
     with pytest.raises(ValueError, match="crop: expected"):
         whitted.render(whitted.load(SHADOWS), crop=crop)
+
+
+@pytest.mark.parametrize("call, fragment", [
+    (lambda b: b.background([float("nan"), 0, 0]), "image.background"),
+    (lambda b: b.ambient([0, float("inf"), 0]), "ambient"),
+    (lambda b: b.point_light([float("nan"), 0, 0], [1, 1, 1]), "point_light.position"),
+    (lambda b: b.point_light([0, 0, 5], [1, float("inf"), 1]), "point_light.intensity"),
+    (lambda b: b.directional_light([0, float("nan"), 0], [1, 1, 1]), "directional_light.direction"),
+    (lambda b: b.sphere([float("inf"), 0, 0], 1, {"kd": 1}), "sphere.center"),
+    (lambda b: b.sphere([0, 0, 0], float("nan"), {"kd": 1}), "sphere.radius"),
+    (lambda b: b.sphere([0, 0, 0], 1, {"kd": [float("nan"), 0, 0]}), "material.kd"),
+    (lambda b: b.sphere([0, 0, 0], 1, {"kd": 1, "p": float("inf")}), "material.p"),
+    (lambda b: b.plane([0, 0, 0], [float("nan"), 1, 0], {"kd": 1}), "plane.normal"),
+    (lambda b: b.box([0, 0, 0], [1, float("inf"), 1], {"kd": 1}), "box.max"),
+    (lambda b: b.triangle([0, 0, 0], [1, 0, 0], [0, float("nan"), 0], {"kd": 1}), "triangle.vertices"),
+])
+def test_scene_builder_refuses_numbers_that_are_not_finite_as_a_file_does(call, fragment):
+    builder = whitted.SceneBuilder().image(8, 8).camera([0, 0, 5], [0, 0, 0])
+    call(builder)
+    with pytest.raises(whitted.Error, match=f"{fragment}: must be a finite number") as raised:
+        builder.build()
+    assert raised.value.file == "<SceneBuilder>" and raised.value.line == 3
+
+
+def test_scene_builder_camera_that_is_not_finite_is_named():
+    with pytest.raises(whitted.Error, match="camera.eye: must be a finite number"):
+        whitted.SceneBuilder().image(8, 8).camera([float("nan"), 0, 5], [0, 0, 0]).build()
+
+
+def test_a_material_colour_may_be_one_number_for_a_grey_and_nothing_else():
+    def pixel(kd):
+        return whitted.render(whitted.SceneBuilder().image(9, 9).camera([0, 0, 5], [0, 0, 0])
+                              .point_light([0, 0, 5], [1, 1, 1]).sphere([0, 0, 0], 1, {"kd": kd}).build())[4, 4]
+    assert np.array_equal(pixel(0.5), pixel([0.5, 0.5, 0.5]))
+    for bad in ("red", [1, 2], None):
+        with pytest.raises(ValueError, match="kd must be a number or three numbers"):
+            pixel(bad)

@@ -244,7 +244,11 @@ private:
         ++m_step;
         for (const TransformStep& step : object.transform) check_step(step);
         const Transform to_world = make_transform(object.transform).then(parent);
-        if (!(std::fabs(to_world.determinant()) > 1e-300))
+        const double determinant = to_world.determinant();
+        if (!std::isfinite(determinant))  // e.g. scales of 1e200 twice: not flat, but past a double
+            fail(object.transform.empty() ? object.where : object.transform.front().where,
+                 "the transform overflows: its steps together scale the object beyond the range of a double");
+        if (!(std::fabs(determinant) > 1e-300))
             fail(object.transform.empty() ? object.where : object.transform.front().where,
                  "the transform is singular (it flattens the object)");
         if (m_prototype && object.type != ObjectType::mesh && object.type != ObjectType::triangle &&
