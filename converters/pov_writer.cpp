@@ -9,13 +9,14 @@
 
 #include "converters/pov_writer.h"
 
+#include "whitted/compat/povray/tie_order.h"
 #include "whitted/core/ray.h"
 #include "whitted/geometry/shapes.h"
 #include "whitted/output/atomic_files.h"
-#include "whitted/compat/povray/tie_order.h"
 #include "whitted/scene/mesh_file.h"
 #include "whitted/scene/msh_file.h"
 #include "whitted/scene/scene.h"
+#include "whitted/scene/text_checks.h"
 
 #include <fmt/format.h>
 
@@ -561,7 +562,17 @@ std::string ini_for(const SceneDescription& d, const std::string& pov_file, cons
     return o;
 }
 
+void check_pov_file_name(const std::string& pov_path) {
+    const std::string name = std::filesystem::path(pov_path).filename().string();
+    for (const unsigned char c : name)
+        if (c < 0x20 || c > 0x7E || c == '"' || c == '\\')
+            throw std::invalid_argument("cannot convert to '" + printable(pov_path, 4096) +
+                                        "': POV-Ray 3.7 opens only files whose names are plain ASCII, without "
+                                        "quotes or backslashes; choose another name for the .pov file");
+}
+
 std::string write_pov_files(const SceneDescription& d, const std::string& pov_path, const ConvertOptions& given) {
+    check_pov_file_name(pov_path);
     ConvertOptions options = given;
     if (!given.hdr_output && radiance_upper_bound(d) * options.exposure > 1.0) options.hdr_output = true;
     const std::filesystem::path pov(pov_path);

@@ -33,6 +33,11 @@ std::string ini_for(const SceneDescription& scene, const std::string& pov_file, 
 /// mirrors summed over max_depth, background): at most 1 means a PNG cannot clip it.
 double radiance_upper_bound(const SceneDescription& scene);
 
+/// Throws std::invalid_argument unless POV-Ray 3.7 can open the file `pov_path` names from the
+/// .ini beside it: its name (the last part of the path) must be printable ASCII without `"` or
+/// `\` (POV-Ray fails to open `café.pov`, and the .ini quotes the name). Called before any work.
+void check_pov_file_name(const std::string& pov_path);
+
 /// Writes `pov_path` and the .ini beside it (same name, .ini). Returns the .ini path.
 /// Throws InputError for anything the description cannot express (mesh files are read here).
 std::string write_pov_files(const SceneDescription& scene, const std::string& pov_path,

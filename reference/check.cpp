@@ -193,7 +193,7 @@ CheckResult run_check(const SceneDescription& description, const std::string& sc
         result.povray_image = options.povray_image;
         result.povray_program = "none: stored image " + options.povray_image;
         const ImageShape shape = read_image_shape(options.povray_image);
-        result.failures = shape_mismatches({ours.width * n, ours.height * n, 3}, shape);
+        result.failures = shape_mismatches({ours.width * n, ours.height * n, 3}, shape, ChannelRule::exact);
         theirs_full = read_linear_image(options.povray_image);
         stored_clipped =
             result.failures.empty() && povray_clipped(theirs_full, ours, n, exposure, options.rule.tolerance);
@@ -221,7 +221,7 @@ CheckResult run_check(const SceneDescription& description, const std::string& sc
         // The size and channels rules: POV-Ray must have written RGB at n·W × n·H. Anything
         // else is a failed comparison, reported as such, not an error of the check.
         const ImageShape shape = read_image_shape((work / povray_image_name).string());
-        result.failures = shape_mismatches({ours.width * n, ours.height * n, 3}, shape);
+        result.failures = shape_mismatches({ours.width * n, ours.height * n, 3}, shape, ChannelRule::exact);
         theirs_full = read_linear_image((work / povray_image_name).string());
         if (!result.failures.empty()) break;
         if (attempt == max_exposure_retries || !povray_clipped(theirs_full, ours, n, exposure, options.rule.tolerance))

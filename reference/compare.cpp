@@ -101,11 +101,17 @@ std::vector<std::string> failed_rules(const ImageComparison& c, const PassRule& 
     return failures;
 }
 
-std::vector<std::string> shape_mismatches(const ImageShape& a, const ImageShape& b) {
+std::vector<std::string> shape_mismatches(const ImageShape& a, const ImageShape& b, ChannelRule channels) {
     std::vector<std::string> failures;
     if (a.width != b.width || a.height != b.height)
         failures.push_back(fmt::format("size ({}x{} vs {}x{})", a.width, a.height, b.width, b.height));
-    if (a.channels != b.channels) failures.push_back(fmt::format("channels ({} vs {})", a.channels, b.channels));
+    if (channels == ChannelRule::exact && a.channels != b.channels)
+        failures.push_back(fmt::format("channels ({} vs {})", a.channels, b.channels));
+    // What is compared is the colour, the first three channels (one, for a grey image): an RGBA
+    // PNG or an EXR with render layers compares with a plain RGB image.
+    else if ((a.channels >= 3) != (b.channels >= 3))
+        failures.push_back(fmt::format("channels ({} vs {}: {} against {})", a.channels, b.channels,
+                                       a.channels >= 3 ? "colour" : "grey", b.channels >= 3 ? "colour" : "grey"));
     return failures;
 }
 

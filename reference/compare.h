@@ -58,8 +58,14 @@ std::vector<std::string> failed_rules(const ImageComparison& comparison, const P
                                       const std::string& ours = "the first image",
                                       const std::string& theirs = "the second image");
 
-/// The size and channels rules: "size (96x72 vs 95x72)", "channels (3 vs 4)", or empty.
-std::vector<std::string> shape_mismatches(const ImageShape& ours, const ImageShape& theirs);
+/// How the channel counts must agree: `colour`, as `whitted compare` reads images (the first three
+/// channels, or one for grey: an RGBA PNG or an EXR with render layers is colour like RGB);
+/// `exact`, as `whitted check` wants POV-Ray's output (RGB, no alpha, as its .ini asks).
+enum class ChannelRule { colour, exact };
+/// The size and channels rules: "size (96x72 vs 95x72)", "channels (3 vs 1: colour against
+/// grey)", or empty.
+std::vector<std::string> shape_mismatches(const ImageShape& ours, const ImageShape& theirs,
+                                          ChannelRule channels = ChannelRule::colour);
 
 /// The figures of a verdict line: "99.913% of pixels within 2/65535 (99.9% required), max
 /// 1000.0 codes (cap 64)".

@@ -543,7 +543,10 @@ int run_convert(const std::string& scene_path, const std::string& output) {
         ini_path.replace_extension(".ini");
         refuse_unwritable(output);
         refuse_overwriting_input(output, scene_path);
-        if (!to_yaml) refuse_unwritable(ini_path), refuse_overwriting_input(ini_path, scene_path);
+        if (!to_yaml) {
+            pov::check_pov_file_name(output);
+            refuse_unwritable(ini_path), refuse_overwriting_input(ini_path, scene_path);
+        }
         const SceneDescription description = parse_scene_file(scene_path);
         validate_scene(description);  // refuse what Whitted itself would refuse
         if (to_yaml) {

@@ -55,6 +55,25 @@ def ini_is_a_directory(whitted, directory):
     return problems
 
 
+def names_povray_cannot_open(whitted, directory):
+    """POV-Ray 3.7 cannot open `café.pov` (nor a name with a quote or a backslash, which the .ini
+    quotes): such a target is refused before any work, and nothing is written."""
+    problems = []
+    source = os.path.join(directory, "a.yaml")
+    with open(source, "w") as f:
+        f.write(scene(64, 0.3))
+    for name in ("café.pov", 'say"hi.pov', "back\\slash.pov", "tab\there.pov"):
+        run = subprocess.run([whitted, "convert", source, os.path.join(directory, name)], capture_output=True,
+                             text=True, timeout=60)
+        if run.returncode != 2 or "POV-Ray 3.7 opens only files whose names are plain ASCII" not in run.stderr:
+            problems.append(f"{name!r}: exit {run.returncode}, {run.stderr!r}")
+        leftovers = sorted(set(os.listdir(directory)) - {"a.yaml"})
+        if leftovers:
+            problems.append(f"{name!r}: files written: {leftovers}")
+        print(f"convert to {name!r}: exit {run.returncode}", "ok" if not problems else "")
+    return problems
+
+
 def concurrent(whitted, directory, rounds):
     problems = []
     sources, expected = {}, {}
@@ -98,6 +117,8 @@ def main():
     failures = []
     with tempfile.TemporaryDirectory(prefix="whitted-convert-faults-") as directory:
         failures += ini_is_a_directory(args.whitted, directory)
+    with tempfile.TemporaryDirectory(prefix="whitted-convert-names-") as directory:
+        failures += names_povray_cannot_open(args.whitted, directory)
     with tempfile.TemporaryDirectory(prefix="whitted-convert-race-") as directory:
         failures += concurrent(args.whitted, directory, args.rounds)
     for problem in failures:
