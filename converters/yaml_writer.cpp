@@ -22,20 +22,57 @@ std::string vec3(const Vec3& v) {
     return "[" + number(v.x) + ", " + number(v.y) + ", " + number(v.z) + "]";
 }
 
-/// A double-quoted YAML string (names and paths may hold any character).
+/// A double-quoted YAML string (names and paths may hold any character) that reads back as the
+/// same text: besides `"` and `\`, every character YAML does not print as itself is escaped (C0 and
+/// C1 controls, DEL, and U+0085, U+2028, U+2029, which a YAML reader takes for line breaks and
+/// folds, U+FEFF, U+FFFE, U+FFFF). A byte that is not UTF-8 is written as the character of that
+/// number (Latin-1's reading of it).
 std::string quoted(const std::string& text) {
     std::string out = "\"";
-    for (const unsigned char c : text) {
+    const auto escape = [&out](uint32_t code) {
+        char buffer[12];
+        if (code <= 0xFF)
+            std::snprintf(buffer, sizeof buffer, "\\x%02x", unsigned(code));
+        else
+            std::snprintf(buffer, sizeof buffer, "\\u%04x", unsigned(code));
+        out += buffer;
+    };
+    const auto* bytes = reinterpret_cast<const unsigned char*>(text.data());
+    for (size_t i = 0; i < text.size();) {
+        const unsigned char c = bytes[i];
         if (c == '"' || c == '\\') {
             out += '\\';
             out += char(c);
-        } else if (c < 0x20) {
-            char escape[8];
-            std::snprintf(escape, sizeof escape, "\\x%02x", c);
-            out += escape;
-        } else {
-            out += char(c);
+            ++i;
+            continue;
         }
+        if (c < 0x80) {
+            if (c < 0x20 || c == 0x7F)
+                escape(c);
+            else
+                out += char(c);
+            ++i;
+            continue;
+        }
+        // One UTF-8 character: its length and code point, or a stray byte.
+        const size_t length = (c & 0xE0) == 0xC0 ? 2 : (c & 0xF0) == 0xE0 ? 3 : (c & 0xF8) == 0xF0 ? 4 : 0;
+        bool valid = length > 0 && i + length <= text.size();
+        uint32_t code = length == 2 ? c & 0x1F : length == 3 ? c & 0x0F : c & 0x07;
+        for (size_t k = 1; valid && k < length; ++k) {
+            valid = (bytes[i + k] & 0xC0) == 0x80;
+            code = (code << 6) | (bytes[i + k] & 0x3F);
+        }
+        if (!valid) {
+            escape(c);
+            ++i;
+            continue;
+        }
+        if ((code >= 0x80 && code <= 0x9F) || code == 0x2028 || code == 0x2029 || code == 0xFEFF || code == 0xFFFE ||
+            code == 0xFFFF)
+            escape(code);
+        else
+            out.append(text, i, length);
+        i += length;
     }
     return out + "\"";
 }
