@@ -244,10 +244,16 @@ private:
         ++m_step;
         for (const TransformStep& step : object.transform) check_step(step);
         const Transform to_world = make_transform(object.transform).then(parent);
-        const double determinant = to_world.determinant();
-        if (!std::isfinite(determinant))  // e.g. scales of 1e200 twice: not flat, but past a double
+        const auto finite = [](const Vec3& v) {
+            return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+        };
+        // Scales of 1e200 twice: not flat, but past a double (the determinant alone may overflow
+        // for a legal scale of 1e300, whose vertices are then refused as beyond float range).
+        if (!finite(to_world.apply_vector({1, 0, 0})) || !finite(to_world.apply_vector({0, 1, 0})) ||
+            !finite(to_world.apply_vector({0, 0, 1})) || !finite(to_world.apply_point({0, 0, 0})))
             fail(object.transform.empty() ? object.where : object.transform.front().where,
                  "the transform overflows: its steps together scale the object beyond the range of a double");
+        const double determinant = to_world.determinant();
         if (!(std::fabs(determinant) > 1e-300))
             fail(object.transform.empty() ? object.where : object.transform.front().where,
                  "the transform is singular (it flattens the object)");
