@@ -162,6 +162,40 @@ def test_sigint_stops_a_render_within_a_second(tmp_path):
     assert took < 1.0, f"the render stopped {took:.2f} s after SIGINT"
 
 
+def test_sigint_stops_even_a_tile_that_takes_minutes(tmp_path):
+    """heavy_tile.yaml: one tile of 256 pixels at 0.34 s each on a core (two facing mirrors, depth
+    256, 16x16 samples, 49 lights). The render heeds the stop between pixels, not only between
+    tiles: before, Ctrl-C waited for the tile (146 s measured)."""
+    heavy = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "robustness", "heavy_tile.yaml")
+    script = textwrap.dedent(f"""
+        import sys
+        sys.path.insert(0, {os.path.dirname(whitted.__file__)!r})
+        import whitted
+        scene = whitted.load({heavy!r})
+        print("rendering", flush=True)
+        try:
+            whitted.render(scene, threads=2)
+        except KeyboardInterrupt:
+            print("interrupted", flush=True)
+            sys.exit(42)
+        print("finished", flush=True)
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True,
+                            env=child_python_env())
+    assert proc.stdout.readline().strip() == "rendering"
+    time.sleep(1.0)  # inside the tile
+    sent = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    try:
+        out, _ = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        raise
+    took = time.monotonic() - sent
+    assert out.strip() == "interrupted" and proc.returncode == 42, (out, proc.returncode)
+    assert took < 5.0, f"the render stopped {took:.2f} s after SIGINT"
+
+
 def test_gil_is_released_while_rendering():
     scene = big_scene(samples=2, size=1000)
     done = threading.Event()
