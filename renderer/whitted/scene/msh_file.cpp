@@ -43,8 +43,11 @@ private:
     int m_line = 1, m_column = 1;
 };
 
+/// A word of the file as a message quotes it: escaped (a terminal never sees its control
+/// characters) and short, since a number is what was expected (a .msh that is a link to another
+/// file should not print that file's first line).
 std::string shown(std::string_view word) {
-    return word.size() > 40 ? std::string(word.substr(0, 37)) + "..." : std::string(word);
+    return printable(word, 16);
 }
 
 double read_number(Words& words, const std::string& what) {
