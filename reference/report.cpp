@@ -196,7 +196,7 @@ std::string report_data_js(const std::string& scene_path, const Image& ours, con
     j["worst_pixels"] = worst;
     return "// Written by whitted check: the data report.html shows (docs/validation.md, \"The report\").\n"
            "window.WHITTED_REPORT = " +
-           j.dump() + ";\n";
+           j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + ";\n";
 }
 
 nlohmann::json metrics_json(const std::string& scene_path, const CheckResult& r, const CheckOptions& options) {
@@ -524,7 +524,10 @@ void write_report(const std::string& dir, const std::string& scene_path, const I
         write_raw_png(heat, difference.width, difference.height, d / "diff.png");
     }
 
-    const std::string metrics = metrics_json(scene_path, result, options).dump(2) + "\n";
+    // A scene's file name may hold bytes that are not UTF-8: written as U+FFFD, so that the
+    // report is JSON whatever the name.
+    const std::string metrics =
+        metrics_json(scene_path, result, options).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
     const std::string html = report_html(dir, scene_path, result, options);
     if (result.comparison.pixels > 0)
         write_files_atomically({{d / "metrics.json", metrics},

@@ -92,6 +92,23 @@ def main():
         if run.returncode != 1 or "FAIL background: max 1000." not in run.stdout or \
                 "codes, 99.913% within; failed: cap (max 1000." not in run.stdout:
             problems.append(f"scripts/validate: exit {run.returncode}, output {run.stdout!r} {run.stderr!r}")
+        # A scene file name that is not UTF-8 (byte 0xE9): the report is still JSON, written whole
+        # (it printed PASS, then failed writing metrics.json with exit 2).
+        latin1 = os.path.join(os.fsencode(directory), b"caf\xe9.yaml")
+        with open(latin1, "w") as f:
+            f.write(SCENE)
+        latin1_report = os.path.join(directory, "latin1-report")
+        run = subprocess.run([os.fsencode(whitted), b"check", latin1, b"-q", b"--report", os.fsencode(latin1_report)],
+                             capture_output=True, env=base, timeout=120)
+        try:
+            with open(os.path.join(latin1_report, "metrics.json"), encoding="utf-8") as f:
+                named = json.load(f)["scene"]
+            ok = run.returncode == 0 and named.endswith("caf\ufffd.yaml")
+        except (OSError, ValueError, KeyError) as e:
+            ok, named = False, repr(e)
+        print(f"scene name not UTF-8: exit {run.returncode}, metrics.json names {named!r}", "ok" if ok else "")
+        if not ok:
+            problems.append(f"scene name not UTF-8: exit {run.returncode}, {run.stderr!r}, {named!r}")
     for problem in problems:
         print("FAIL " + problem)
     sys.exit(1 if problems else 0)
