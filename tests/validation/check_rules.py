@@ -109,6 +109,23 @@ def main():
         print(f"scene name not UTF-8: exit {run.returncode}, metrics.json names {named!r}", "ok" if ok else "")
         if not ok:
             problems.append(f"scene name not UTF-8: exit {run.returncode}, {run.stderr!r}, {named!r}")
+        # A report directory under a file is a usage error found before the scene is even read: with
+        # a scene that is itself wrong, the report directory is what the message names (it was
+        # found only after the render, 28-38 s into a large scene). The fake POV-Ray never runs.
+        blocker = os.path.join(directory, "a-file")
+        with open(blocker, "w") as f:
+            f.write("not a directory\n")
+        broken = os.path.join(directory, "broken.yaml")
+        with open(broken, "w") as f:
+            f.write("version: 1\nimage: {width: x}\n")
+        marker = os.path.join(directory, "povray-ran")
+        run = subprocess.run([whitted, "check", broken, "-q", "--report", os.path.join(blocker, "report")],
+                             capture_output=True, text=True, env=dict(base, FAKE_POVRAY_MARKER=marker), timeout=120)
+        ok = run.returncode == 2 and f"'{blocker}' is not a directory" in run.stderr and \
+            "broken.yaml" not in run.stderr and not os.path.exists(marker)
+        print(f"report under a file: exit {run.returncode}: {run.stderr.strip()}", "ok" if ok else "")
+        if not ok:
+            problems.append(f"report under a file: exit {run.returncode}, {run.stderr!r}")
     for problem in problems:
         print("FAIL " + problem)
     sys.exit(1 if problems else 0)

@@ -32,6 +32,8 @@ def install(directory):
 
 def main():
     text = open(sys.argv[1]).read()
+    if os.environ.get("FAKE_POVRAY_MARKER"):  # a test's proof that POV-Ray was run
+        open(os.environ["FAKE_POVRAY_MARKER"], "w").close()
     mode = os.environ.get("FAKE_POVRAY_MODE", "image")
     if mode.startswith("hang"):
         if mode == "hang-ignoring-signals":
