@@ -165,6 +165,10 @@ with open(os.path.join(work, "keep.exr"), "rb") as f:
 result = run(["render", base, "-q", "-o", "keep.exr", "--width", "65536"], expect=2)
 check(f"65536x{int(65536 * 61 / 97 + 0.5)}".encode() in result.stderr, f"--width 65536: {result.stderr!r}")
 
+# check's thread count is checked as render's is (10**9 crashed in TBB's arena set-up).
+result = run(["check", base, "-q", "-t", "1000000000"], expect=2)
+check(b"--threads" in result.stderr, f"check -t 10**9: {result.stderr!r}")
+
 # --- suggestions ------------------------------------------------------------------------------------
 result = run(["rendr", base], expect=2)
 check(b"did you mean 'render'" in result.stderr, f"rendr: {result.stderr!r}")

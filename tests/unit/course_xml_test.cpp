@@ -7,6 +7,7 @@
 #include "whitted/render/camera.h"
 #include "whitted/render/shading.h"
 #include "whitted/scene/scene.h"
+#include "whitted/scene/text_checks.h"
 
 #include <gtest/gtest.h>
 
@@ -153,6 +154,35 @@ TEST(CourseXml, DeepNestingIsRefusedWhereItPassesTheLimit) {
             EXPECT_EQ(e.where().str(), "deep.xml:1:" + std::to_string(7 + 511 * 9 + 1)) << levels;
         }
     }
+}
+
+// Shaders are found by a hash look-up, and the unknown-shader message lists at most 20 names,
+// each escaped and cut short (a file of 100,000 shaders or megabyte names gave 20 MB messages).
+TEST(CourseXml, UnknownShaderMessageIsBounded) {
+    std::string text = "<scene><camera/><image>1 1</image>\n";
+    for (int i = 0; i < 30; ++i)
+        text += "<shader name=\"" + std::string(100, 'a') + std::to_string(i) +
+                "\" type=\"Lambertian\"><diffuseColor>1 1 1</diffuseColor></shader>\n";
+    text += "<surface type=\"Sphere\"><shader ref=\"nope\"/></surface></scene>";
+    try {
+        parse_course_xml_text(text, "many.xml");
+        ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+        const std::string message = e.what();
+        EXPECT_LT(message.size(), 2000u) << message.size();
+        EXPECT_NE(message.find("unknown shader 'nope'"), std::string::npos) << message;
+        EXPECT_NE(message.find("... (30 in all)"), std::string::npos) << message;
+    }
+}
+
+TEST(Printable, ControlsC1AndBytesThatAreNotUtf8AreEscaped) {
+    EXPECT_EQ(printable("a\x1b[2Jb\x07"), "a\\x1b[2Jb\\x07");
+    EXPECT_EQ(printable("\xc2\x9b"
+                        "2J"),
+              "\\x9b2J");                                                          // U+009B, a terminal's CSI
+    EXPECT_EQ(printable("Gr\xfcn"), "Gr\\xfcn");                                   // Latin-1, not UTF-8
+    EXPECT_EQ(printable("Gr\xc3\xbcn \xe2\x80\xa8"), "Gr\xc3\xbcn \xe2\x80\xa8");  // UTF-8 stays
+    EXPECT_EQ(printable(std::string(100, 'x'), 10), "xxxxxxxxxx... (100 bytes)");
 }
 
 TEST(Shading, SchlickFresnelClosedForm) {

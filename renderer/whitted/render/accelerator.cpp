@@ -782,6 +782,10 @@ struct Accelerator::Impl {
                                   largest(to_world.inverse_vector({0, 1, 0})) +
                                   largest(to_world.inverse_vector({0, 0, 1}));
             const double in_prototype = shrink * origins + largest(to_world.inverse_point({0, 0, 0}));
+            // The other way: a prototype of ±1e-20 enlarged by 1e20 aborted in Embree too (its rays'
+            // directions shrink by as much in its space), while 1e19 rendered.
+            const double grow = largest(to_world.apply_vector({1, 0, 0})) + largest(to_world.apply_vector({0, 1, 0})) +
+                                largest(to_world.apply_vector({0, 0, 1}));
             const double prototype_reach = std::max(largest(prototype.lo), largest(prototype.hi));
             const SourceLocation where = instance.object > 0 && instance.object <= scene.objects.size()
                                              ? scene.objects[instance.object - 1].where
@@ -792,6 +796,12 @@ struct Accelerator::Impl {
                 throw InputError(where, std::string("instance: its prototype reaches ") + figure +
                                             " from the origin of its own space; Whitted renders prototypes within "
                                             "1e15 of it (scale its triangles down and the instance up)");
+            }
+            if (!(grow <= max_instance_origin)) {
+                std::snprintf(figure, sizeof figure, "%g", grow);
+                throw InputError(where, std::string("instance: its transform enlarges the prototype ") + figure +
+                                            " times; Whitted renders instances enlarged up to 1e17 times (scale the "
+                                            "prototype's triangles up instead)");
             }
             if (!(in_prototype <= max_instance_origin)) {
                 std::snprintf(figure, sizeof figure, "%g", in_prototype);

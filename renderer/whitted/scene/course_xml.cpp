@@ -19,6 +19,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <unordered_map>
 
 namespace whitted {
 namespace {
@@ -211,14 +212,19 @@ Located<int64_t> integer(const Element& e, const Located<double>& n) {
     return out;
 }
 
+/// Names for a message: each escaped and cut short, at most 20 of them, then how many in all (a
+/// hostile file may name 100,000 shaders, each megabytes long).
 std::string join(const std::vector<std::string>& words) {
+    constexpr size_t most_listed = 20;
     std::string out;
-    for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
+    for (size_t i = 0; i < words.size() && i < most_listed; ++i)
+        out += (out.empty() ? "" : ", ") + printable(words[i], 40);
+    if (words.size() > most_listed) out += ", ... (" + std::to_string(words.size()) + " in all)";
     return out;
 }
 
 [[noreturn]] void unknown_element(const Element& child, const Element& parent, const std::vector<std::string>& known) {
-    throw InputError(child.where, "<" + parent.name + ">: unknown element <" + child.name + ">" +
+    throw InputError(child.where, "<" + parent.name + ">: unknown element <" + printable(child.name) + ">" +
                                       did_you_mean(child.name, known) + "; expected one of: " + join(known));
 }
 
@@ -495,20 +501,22 @@ private:
         check_attributes(e, {"name", "type"});
         const std::string* name = e.attribute("name");
         if (!name || name->empty()) throw InputError(e.where, "<shader>: a shader outside a surface needs a 'name'");
-        if (scene.find_material(*name)) throw InputError(e.where, "<shader>: '" + *name + "' is defined twice");
+        if (!m_shader_index.try_emplace(*name, scene.materials.size()).second)
+            throw InputError(e.where, "<shader>: '" + printable(*name) + "' is defined twice");
         MaterialDescription material = read_shader_body(e, true);
         material.name = *name;
         scene.materials.push_back(material);
     }
 
+    /// By one hash look-up (a scene of 100,000 shaders and surfaces was quadratic); the names are
+    /// gathered only for the message.
     const MaterialDescription* find_shader(const std::string& name, const SourceLocation& where) const {
+        if (const auto it = m_shader_index.find(name); m_shaders && it != m_shader_index.end())
+            return &(*m_shaders)[it->second];
         std::vector<std::string> names;
         if (m_shaders)
-            for (const auto& m : *m_shaders) {
-                if (m.name == name) return &m;
-                names.push_back(m.name);
-            }
-        throw InputError(where, "unknown shader '" + name + "'" + did_you_mean(name, names) +
+            for (const auto& m : *m_shaders) names.push_back(m.name);
+        throw InputError(where, "unknown shader '" + printable(name) + "'" + did_you_mean(name, names) +
                                     (names.empty() ? "; the scene names no shaders" : "; defined: " + join(names)));
     }
 
@@ -644,6 +652,7 @@ private:
 
     std::string m_path, m_directory;
     const std::vector<MaterialDescription>* m_shaders = nullptr;
+    std::unordered_map<std::string, size_t> m_shader_index;  ///< shader name -> index in *m_shaders
 };
 
 }  // namespace

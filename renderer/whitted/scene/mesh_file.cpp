@@ -164,6 +164,10 @@ std::string count_of(int64_t count, const std::string& noun) {
 /// always valid text whatever bytes the file had.
 std::string quote_name(std::string_view name) {
     static const char hex[] = "0123456789ABCDEF";
+    // A name of megabytes (a hostile usemtl) is cut: a message stays a line.
+    constexpr size_t longest = 60;
+    if (name.size() > longest)
+        return quote_name(name.substr(0, longest)) + "... (" + std::to_string(name.size()) + " bytes)";
     std::string out = "'";
     const auto* bytes = reinterpret_cast<const unsigned char*>(name.data());
     for (size_t i = 0; i < name.size();) {

@@ -96,8 +96,22 @@ std::string printable(std::string_view text, size_t max_characters) {
             ++i;
             continue;
         }
-        size_t length = c < 0x80 ? 1 : c >= 0xF0 ? 4 : c >= 0xE0 ? 3 : 2;  // one UTF-8 character
-        length = std::min(length, text.size() - i);
+        // One UTF-8 character, or a byte that does not start one (Latin-1 text, say), escaped. C1
+        // controls (U+0080 to U+009F: U+009B is a terminal's CSI) are escaped as the C0 ones are.
+        const size_t length = c < 0x80             ? 1
+                              : (c & 0xE0) == 0xC0 ? 2
+                              : (c & 0xF0) == 0xE0 ? 3
+                              : (c & 0xF8) == 0xF0 ? 4
+                                                   : 0;
+        bool valid = length > 0 && i + length <= text.size();
+        for (size_t k = 1; valid && k < length; ++k) valid = (static_cast<unsigned char>(text[i + k]) & 0xC0) == 0x80;
+        const bool c1 = valid && length == 2 && c == 0xC2 && static_cast<unsigned char>(text[i + 1]) < 0xA0;
+        if (!valid || c1) {
+            const auto shown = c1 ? static_cast<unsigned char>(text[i + 1]) : c;
+            out += std::string{'\\', 'x', hex[shown >> 4], hex[shown & 15]};
+            i += c1 ? 2 : 1;
+            continue;
+        }
         out.append(text.substr(i, length));
         i += length;
     }

@@ -53,9 +53,10 @@ private:
     size_t m_let_go = 0;  ///< bytes from the start let go by the latest reader (whole pages)
 };
 
-/// `text` made safe to print in a message: control characters (ESC, BEL, ...) written as \xNN
-/// escapes, so a scene cannot drive the terminal, and at most `max_characters` characters, the
-/// rest replaced by "... (N bytes)". `text` must be valid UTF-8 (as a checked scene is).
+/// `text` made safe to print in a message: control characters (C0 such as ESC and BEL, DEL, and
+/// C1 such as U+009B) and bytes that are not UTF-8 (Latin-1 names) written as \xNN escapes, so a
+/// scene cannot drive the terminal, and at most `max_characters` characters, the rest replaced
+/// by "... (N bytes)".
 std::string printable(std::string_view text, size_t max_characters = 60);
 
 /// " (did you mean 'x'?)" for the closest candidate within a small edit distance, else "".
