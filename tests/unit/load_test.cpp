@@ -313,6 +313,10 @@ TEST(LoadScene, AMeshKeepsItsFloatsWhereverItIsMoved) {
 TEST(SceneFormat, TheExtensionFirstThenTheFirstLine) {
     EXPECT_EQ(scene_format("a.xml", "version: 1"), SceneFormat::course_xml);
     EXPECT_EQ(scene_format("a.NFF", "version: 1"), SceneFormat::nff);
+    // A YAML or JSON name is YAML whatever the text, as a file of that name is read.
+    EXPECT_EQ(scene_format("scene.yaml", "# a comment\nv\nfrom 0 0 1\n"), SceneFormat::yaml);
+    EXPECT_EQ(scene_format("scene.JSON", "<scene/>"), SceneFormat::yaml);
+    EXPECT_EQ(scene_format("scene.yml", "v\n"), SceneFormat::yaml);
     EXPECT_EQ(scene_format("<stdin>", "# a comment\n#another\nv\nfrom 0 0 1\n"), SceneFormat::nff);
     for (const char* keyword : {"v", "b", "l", "f", "c", "s", "p", "pp"})
         EXPECT_EQ(scene_format("<stdin>", std::string(keyword) + " 1 2 3\n"), SceneFormat::nff) << keyword;

@@ -246,9 +246,10 @@ SceneDescription parse_scene_text(std::string_view text, const std::string& path
 
 /// The three kinds of scene text Whitted reads.
 enum class SceneFormat { yaml, course_xml, nff };
-/// A scene's format by its name's extension (`.xml`, `.nff`, as parse_scene_file decides), else
-/// by how its text begins: NFF's one-letter entities (after `#` comment lines), XML's `<`, else
-/// YAML (JSON included). For text with no file name, such as a scene on standard input.
+/// A scene's format by its name's extension (`.xml`, `.nff`; `.yaml`, `.yml`, `.json` are YAML),
+/// as parse_scene_file decides; for a name without one of those (`<stdin>`, `<string>`), by how
+/// its text begins: NFF's one-letter entities (after `#` comment lines), XML's `<`, else YAML
+/// (JSON included).
 SceneFormat scene_format(const std::string& path, std::string_view text);
 /// parse_scene_text, parse_course_xml_text or parse_nff_text, as scene_format says.
 SceneDescription parse_any_scene_text(std::string_view text, const std::string& path, const ObjectSink* sink = nullptr);

@@ -13,6 +13,7 @@
 #include "whitted/scene/yaml_tree.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <exception>
@@ -792,6 +793,11 @@ SceneDescription hand_objects_to(const ObjectSink* sink, SceneDescription descri
 SceneFormat scene_format(const std::string& path, std::string_view text) {
     if (is_course_xml_path(path)) return SceneFormat::course_xml;
     if (is_nff_path(path)) return SceneFormat::nff;
+    // A name that says YAML or JSON is read so, as parse_scene_file reads such a file.
+    std::string extension = std::filesystem::path(path).extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    if (extension == ".yaml" || extension == ".yml" || extension == ".json") return SceneFormat::yaml;
     // An NFF file's first entity, after any `#` comment lines, is a one-letter keyword on its own
     // word (a YAML scene may begin with `#` comments too, then a key such as `version:`).
     size_t line = 0;
