@@ -152,7 +152,8 @@ struct SceneOverrides {
 WHITTED_API Expected<Scene> load_scene_file(const std::string& path, const SceneOverrides& overrides = {});
 /// The same from text in memory; `name` stands for the file in messages, and relative mesh
 /// paths are resolved against its directory. The format is the one `name`'s extension says
-/// (.xml, .nff), else the one the text's first line says (NFF entities, XML's `<`, else YAML).
+/// (.xml, .nff; .yaml, .yml, .json), else the one the text's first line says (NFF entities,
+/// XML's `<`, else YAML).
 WHITTED_API Expected<Scene> load_scene_string(const std::string& text, const std::string& name = "<string>",
                                               const SceneOverrides& overrides = {});
 
