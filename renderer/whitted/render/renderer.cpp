@@ -199,32 +199,18 @@ TileRect render_tile_rect(int width, int height, size_t t) {
 
 namespace {
 
-/// A tile's pixels in the image and its layers, kept to put back (a tile stopped midway).
+/// A tile's pixels in the image and its layers (crop_image's cut), kept to put back (a tile
+/// stopped midway).
 class TileContents {
 public:
-    TileContents(const Image& image, const TileRect& rect) : m_rect(rect) {
-        m_saved.push_back(copy(image.rgb, image.width, 3));
-        for (const ImageLayer& layer : image.layers)
-            m_saved.push_back(copy(layer.values, image.width, layer.channels.size()));
-    }
+    TileContents(const Image& image, const TileRect& rect) : m_rect(rect), m_saved(crop_image(image, rect)) {}
     void restore(Image& image) const {
-        paste(m_saved[0], image.rgb, image.width, 3);
+        paste(m_saved.rgb, image.rgb, image.width, 3);
         for (size_t k = 0; k < image.layers.size(); ++k)
-            paste(m_saved[k + 1], image.layers[k].values, image.width, image.layers[k].channels.size());
+            paste(m_saved.layers[k].values, image.layers[k].values, image.width, image.layers[k].channels.size());
     }
 
 private:
-    std::vector<float> copy(const std::vector<float>& values, int width, size_t channels) const {
-        std::vector<float> out;
-        const size_t row = size_t(m_rect.x_end - m_rect.x_begin) * channels;
-        out.reserve(row * size_t(m_rect.y_end - m_rect.y_begin));
-        for (int y = m_rect.y_begin; y < m_rect.y_end; ++y) {
-            const auto first =
-                values.begin() + ptrdiff_t((size_t(y) * size_t(width) + size_t(m_rect.x_begin)) * channels);
-            out.insert(out.end(), first, first + ptrdiff_t(row));
-        }
-        return out;
-    }
     void paste(const std::vector<float>& saved, std::vector<float>& values, int width, size_t channels) const {
         const size_t row = size_t(m_rect.x_end - m_rect.x_begin) * channels;
         for (int y = m_rect.y_begin; y < m_rect.y_end; ++y)
@@ -233,7 +219,7 @@ private:
     }
 
     TileRect m_rect;
-    std::vector<std::vector<float>> m_saved;  ///< the beauty, then each layer
+    Image m_saved;  ///< the tile's rectangle of the image, layers included
 };
 
 }  // namespace
