@@ -131,13 +131,15 @@ def test_progress_reports_completion():
     assert calls and calls[-1][0] == calls[-1][1] > 0
 
 
-def test_sigint_stops_a_render_within_a_second(tmp_path):
+def seconds_to_stop_on_sigint(load_scene, wait, timeout):
+    """Starts a child python3 that renders the scene `load_scene` (Python source) makes, sends it
+    SIGINT after `wait` seconds, checks that it raised KeyboardInterrupt within `timeout` seconds,
+    and returns how long it took to stop."""
     script = textwrap.dedent(f"""
-        import sys, time
+        import sys
         sys.path.insert(0, {os.path.dirname(whitted.__file__)!r})
         import whitted
-        scene = (whitted.SceneBuilder().image(2000, 2000, 8).camera([0, 0, 5], [0, 0, 0])
-                 .point_light([0, 0, 5], [1, 1, 1]).sphere([0, 0, 0], 1.5, {{"kd": [0.5, 0.5, 0.5]}}).build())
+        scene = {load_scene}
         print("rendering", flush=True)
         try:
             whitted.render(scene, threads=2)
@@ -149,16 +151,23 @@ def test_sigint_stops_a_render_within_a_second(tmp_path):
     proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True,
                             env=child_python_env())
     assert proc.stdout.readline().strip() == "rendering"
-    time.sleep(0.5)  # well inside the render
+    time.sleep(wait)
     sent = time.monotonic()
     proc.send_signal(signal.SIGINT)
     try:
-        out, _ = proc.communicate(timeout=10)
+        out, _ = proc.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
         proc.kill()
         raise
-    took = time.monotonic() - sent
     assert out.strip() == "interrupted" and proc.returncode == 42, (out, proc.returncode)
+    return time.monotonic() - sent
+
+
+def test_sigint_stops_a_render_within_a_second(tmp_path):
+    took = seconds_to_stop_on_sigint(
+        '(whitted.SceneBuilder().image(2000, 2000, 8).camera([0, 0, 5], [0, 0, 0])'
+        '.point_light([0, 0, 5], [1, 1, 1]).sphere([0, 0, 0], 1.5, {"kd": [0.5, 0.5, 0.5]}).build())',
+        wait=0.5, timeout=10)  # well inside the render
     assert took < 1.0, f"the render stopped {took:.2f} s after SIGINT"
 
 
@@ -167,32 +176,7 @@ def test_sigint_stops_even_a_tile_that_takes_minutes(tmp_path):
     256, 16x16 samples, 49 lights). The render heeds the stop between pixels, not only between
     tiles: before, Ctrl-C waited for the tile (146 s measured)."""
     heavy = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "robustness", "heavy_tile.yaml")
-    script = textwrap.dedent(f"""
-        import sys
-        sys.path.insert(0, {os.path.dirname(whitted.__file__)!r})
-        import whitted
-        scene = whitted.load({heavy!r})
-        print("rendering", flush=True)
-        try:
-            whitted.render(scene, threads=2)
-        except KeyboardInterrupt:
-            print("interrupted", flush=True)
-            sys.exit(42)
-        print("finished", flush=True)
-    """)
-    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True,
-                            env=child_python_env())
-    assert proc.stdout.readline().strip() == "rendering"
-    time.sleep(1.0)  # inside the tile
-    sent = time.monotonic()
-    proc.send_signal(signal.SIGINT)
-    try:
-        out, _ = proc.communicate(timeout=60)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        raise
-    took = time.monotonic() - sent
-    assert out.strip() == "interrupted" and proc.returncode == 42, (out, proc.returncode)
+    took = seconds_to_stop_on_sigint(f"whitted.load({heavy!r})", wait=1.0, timeout=60)  # inside the tile
     assert took < 5.0, f"the render stopped {took:.2f} s after SIGINT"
 
 
