@@ -635,6 +635,23 @@ std::string version_text() {
     return text;
 }
 
+/// The folder holding the docs/ and examples/ that --help names: PREFIX/share/whitted beside an
+/// installed program, else the source checkout a build tree was made from; empty when neither
+/// is there (a program copied elsewhere), and --help then names them alone.
+std::string documentation_root() {
+    std::error_code error;
+    const std::filesystem::path program = std::filesystem::read_symlink("/proc/self/exe", error);
+    if (!error) {
+        const std::filesystem::path installed = program.parent_path().parent_path() / "share" / "whitted";
+        if (std::filesystem::is_directory(installed / "docs", error)) return installed.string();
+    }
+#ifdef WHITTED_SOURCE_DIR
+    if (std::filesystem::is_directory(std::filesystem::path(WHITTED_SOURCE_DIR) / "docs", error))
+        return WHITTED_SOURCE_DIR;
+#endif
+    return {};
+}
+
 /// WHITTED_EMBREE_ISA, checked before any work: a name Embree does not know, or an instruction
 /// set this CPU lacks, is a usage error (exit 2), not a failure after parsing and loading.
 bool embree_isa_usable() {
@@ -678,7 +695,9 @@ int main(int argc, char** argv) {
         "Scene format: docs/scene-format.md. Examples: examples/lecture/.\n"
         "Cornell CS4620 course scenes (.xml, with .msh meshes) render and convert directly, with the\n"
         "course's conventions: docs/course-format.md (its images: --display 'Gamma 2.2').\n"
-        "NFF scenes (.nff, Eric Haines' SPD databases) render, convert and check directly: docs/nff.md.");
+        "NFF scenes (.nff, Eric Haines' SPD databases) render, convert and check directly: docs/nff.md." +
+        (documentation_root().empty() ? std::string()
+                                      : "\nThe docs/ and examples/ named here are in " + documentation_root() + "/."));
 
     RenderArguments render_args;
     CLI::App* render_cmd = app.add_subcommand(
@@ -860,8 +879,12 @@ int main(int argc, char** argv) {
     // A mistyped command gets its nearest name (CLI11 would say only that one is required).
     if (argc > 1 && argv[1][0] != '-') {
         std::vector<std::string> commands;
-        for (const CLI::App* command : app.get_subcommands({})) commands.push_back(command->get_name());
-        if (std::find(commands.begin(), commands.end(), argv[1]) == commands.end()) {
+        bool known = false;  // by name or alias ("color")
+        for (const CLI::App* command : app.get_subcommands({})) {
+            commands.push_back(command->get_name());
+            known = known || command->check_name(argv[1]);
+        }
+        if (!known) {
             std::string list;
             for (const std::string& name : commands) list += (list.empty() ? "" : ", ") + name;
             print_error("unknown command '" + printable(argv[1]) + "'" + did_you_mean(argv[1], commands) +

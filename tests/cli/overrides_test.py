@@ -169,9 +169,17 @@ check(f"65536x{int(65536 * 61 / 97 + 0.5)}".encode() in result.stderr, f"--width
 result = run(["check", base, "-q", "-t", "1000000000"], expect=2)
 check(b"--threads" in result.stderr, f"check -t 10**9: {result.stderr!r}")
 
+import re
+
 # --- suggestions ------------------------------------------------------------------------------------
 result = run(["rendr", base], expect=2)
 check(b"did you mean 'render'" in result.stderr, f"rendr: {result.stderr!r}")
+# Every name --help lists is a command, aliases too ("colour, color").
+for line in run(["--help"]).stdout.decode().split("Subcommands:\n", 1)[1].splitlines():
+    if not line.startswith("  "):
+        break
+    for name in re.split(r"  +", line.strip())[0].split(", "):
+        run([name, "--help"], expect=0)
 result = run(["render", base, "-o", "x.exr", "--layers", "difuse"], expect=2)
 check(b"did you mean 'diffuse'" in result.stderr, f"--layers difuse: {result.stderr!r}")
 result = run(["\x1b]0;title\x07"], expect=2)

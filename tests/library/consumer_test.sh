@@ -6,20 +6,22 @@
 # and checks its centre pixel against the lecture's formula (exit 0 only when it is right).
 # Also: the installed `whitted` finds the plug-in next to libwhitted.so, and its EXR matches the
 # consumer's, which writes the same scene through api::write_image.
-# Usage: consumer_test.sh BUILD_DIR SOURCE_DIR [PYTHON_MODULE=ON|OFF]
+# The module goes where Debian's python3 looks under a prefix that is not /usr:
+# lib/python3.X/dist-packages (site.getsitepackages names it for the prefix).
+# Usage: consumer_test.sh BUILD_DIR SOURCE_DIR LIBDIR [PYTHON_MODULE=ON|OFF]
 set -euo pipefail
-build=$1 source=$2 python_module=${3:-ON}
+build=$1 source=$2 libdir=$3 python_module=${4:-ON}
 work="$build/library-test"
 rm -rf "$work"
 mkdir -p "$work"
 prefix="$work/prefix"
 cmake --install "$build" --prefix "$prefix" >"$work/install.log"
 for f in include/whitted/whitted.h include/whitted/image.h include/whitted/version.h \
-         lib/cmake/Whitted/WhittedConfig.cmake lib/cmake/Whitted/WhittedConfigVersion.cmake \
-         lib/pkgconfig/whitted.pc bin/whitted lib/libwhitted_oiio.so; do
+         "$libdir/cmake/Whitted/WhittedConfig.cmake" "$libdir/cmake/Whitted/WhittedConfigVersion.cmake" \
+         "$libdir/pkgconfig/whitted.pc" bin/whitted "$libdir/libwhitted_oiio.so"; do
   [ -e "$prefix/$f" ] || { echo "FAIL: $f not installed"; exit 1; }
 done
-ls "$prefix"/lib/libwhitted.so.0.2 >/dev/null
+ls "$prefix/$libdir/libwhitted.so.0.2" >/dev/null
 
 echo "== find_package(Whitted 0.2) build"
 cmake -S "$source/examples/library" -B "$work/consumer" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" \
@@ -42,12 +44,12 @@ if cmake -S "$work/wrong_version" -B "$work/wrong_version/build" -DCMAKE_PREFIX_
 fi
 
 echo "== pkg-config build"
-export PKG_CONFIG_PATH="$prefix/lib/pkgconfig"
+export PKG_CONFIG_PATH="$prefix/$libdir/pkgconfig"
 [ "$(pkg-config --modversion whitted)" = "$("$prefix/bin/whitted" --version | head -n 1 | cut -d' ' -f2)" ] ||
   { echo "FAIL: pkg-config version differs from whitted --version"; exit 1; }
 # shellcheck disable=SC2046
 c++ -O2 -o "$work/one_sphere_pc" "$source/examples/library/one_sphere.cpp" $(pkg-config --cflags --libs whitted) \
-  -Wl,-rpath,"$prefix/lib"
+  -Wl,-rpath,"$prefix/$libdir"
 with_runtime "$work/one_sphere_pc"
 
 echo "== the installed program and the plug-in beside the library"
@@ -57,8 +59,10 @@ echo "== the installed Python module, and the plug-in found beside the installed
 python=${WHITTED_TEST_PYTHON:-/usr/bin/python3}
 if [ "$python_module" = OFF ]; then
   echo "(built with -DWHITTED_BUILD_PYTHON=OFF: no Python module to check)"
-elif [ -x "$python" ] && [ -d "$prefix/lib/python3/dist-packages" ]; then
-  PYTHONPATH="$prefix/lib/python3/dist-packages" with_runtime "$python" - "$prefix" "$work/consumer.exr" <<'PY'
+else
+  site=$("$python" -c 'import site, sys; print(site.getsitepackages([sys.argv[1]])[-1])' "$prefix")
+  [ -d "$site" ] || { echo "FAIL: no Python module installed under $site, where $python looks under $prefix"; exit 1; }
+  PYTHONPATH="$site" with_runtime "$python" - "$prefix" "$work/consumer.exr" <<'PY'
 import sys
 import numpy as np
 import whitted
@@ -71,12 +75,10 @@ image = whitted.render(scene, threads=2)
 # The same scene as one_sphere's, so the same pixels as the EXR it wrote through the C++ API.
 whitted.write_image(image, exr + ".py.exr")
 maps = open("/proc/self/maps").read()
-assert prefix + "/lib/libwhitted.so" in maps, "libwhitted.so not loaded from the prefix"
+assert prefix + "/lib/" in maps and "libwhitted.so" in maps, "libwhitted.so not loaded from the prefix"
 print("python: module and libwhitted.so from the prefix")
 PY
   # Bit for bit, through the installed plug-in (whitted compare loads it).
   "$prefix/bin/whitted" compare "$work/consumer.exr" "$work/consumer.exr.py.exr" --tolerance 0 --max-error 0
-else
-  echo "FAIL: no Python module installed under $prefix/lib/python3/dist-packages"; exit 1
 fi
 echo "PASS"
