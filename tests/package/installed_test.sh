@@ -28,7 +28,7 @@ whitted convert "$scene" several.pov || fail "convert"
 [ -s several.pov ] && [ -s several.ini ] || fail "convert wrote no .pov/.ini"
 command -v povray >/dev/null || fail "povray (Recommends) was not installed with the package"
 whitted check "$scene" -q --report report || fail "check against POV-Ray"
-[ -s report/index.html ] && [ -s report/metrics.json ] || fail "check wrote no report"
+[ -s report/report.html ] && [ -s report/metrics.json ] || fail "check wrote no report"
 whitted compare several.exr several.exr --tolerance 0 --max-error 0 >/dev/null || fail "compare"
 say "explain, convert, check (report in report/), compare"
 
