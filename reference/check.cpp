@@ -11,6 +11,7 @@
 #include "whitted/render/renderer.h"
 #include "whitted/scene/description.h"
 #include "whitted/scene/scene.h"
+#include "whitted/scene/text_checks.h"
 
 #include <fmt/format.h>
 
@@ -150,10 +151,29 @@ void check_report_dir(const CheckOptions& options) {
     }
 }
 
+/// Every file `check --report` may write in the report directory.
+constexpr const char* report_files[] = {pov_name,       ini_name,         povray_image_name, "povray.log", "ours.exr",
+                                        "povray.exr",   "diff.exr",       "ours.png",        "povray.png", "diff.png",
+                                        "metrics.json", "report-data.js", "report.html"};
+
+/// A report file that is one of the check's inputs (the scene, a mesh or MTL file, by any name:
+/// a scene copied to `r/metrics.json`) is a usage error before the render: the report would
+/// replace it.
+void refuse_report_over_inputs(const CheckOptions& options) {
+    if (options.report_dir.empty()) return;
+    for (const char* name : report_files) {
+        const fs::path target = fs::path(options.report_dir) / name;
+        if (const std::string input = input_file_at(target.string()); !input.empty())
+            throw std::invalid_argument("cannot write the report file '" + target.string() + "': it is " + input +
+                                        ", an input of the same check");
+    }
+}
+
 }  // namespace
 
 CheckResult run_check(const std::string& scene_path, const CheckOptions& options) {
     check_report_dir(options);
+    const InputFilesNoted inputs;  // for refuse_report_over_inputs
     return run_check(parse_scene_file(scene_path), scene_path, options);
 }
 
@@ -164,7 +184,8 @@ CheckResult run_check(const SceneDescription& description, const std::string& sc
     // 1. Whitted, as `whitted render` does it, with POV-Ray's intersection decisions
     //    (render.intersection: povray), so that the two can agree pixel by pixel where an exact
     //    answer and POV-Ray's differ (at an edge, a graze, a tie).
-    Scene scene = validate_scene(description);
+    Scene scene = validate_scene(description);  // reads the meshes
+    refuse_report_over_inputs(options);
     scene.intersection = Intersection::povray;
     Image ours;
     {
@@ -333,6 +354,7 @@ std::vector<TermScene> term_scenes(const SceneDescription& description) {
 }
 
 bool run_check_terms(const std::string& scene_path, const CheckOptions& options) {
+    const InputFilesNoted inputs;  // for refuse_report_over_inputs
     const SceneDescription description = parse_scene_file(scene_path);
     const std::vector<TermScene> terms = term_scenes(description);
     if (terms.empty()) throw InputError({scene_path}, "check --terms: the scene has no term to isolate");

@@ -79,6 +79,9 @@ Expected<Scene> load(const std::string& label, const std::function<void(Scene::I
     } catch (const std::bad_alloc&) {
         // A scene or mesh too large for this machine's memory: an error, never an abort.
         return plain_error("out of memory while reading the scene", Error::Kind::failure, label);
+    } catch (const FileChangedWhileRead& e) {
+        // Not the input's fault: another program changed it under the reader (exit 1).
+        return plain_error(e.what(), Error::Kind::failure, label);
     } catch (const std::exception& e) {  // e.g. a filesystem error while reading
         return plain_error(e.what(), Error::Kind::bad_input, label);
     }

@@ -348,6 +348,7 @@ int run_render(const RenderArguments& args) {
         }
         check_output_options(args.output, output);
         if (args.scene != "-") refuse_output_over(args.output, args.scene, "scene file");
+        refuse_symlink_target(args.output);
     };
     if (const int status = exit_on_input_error(args.scene, check_usage); status >= 0) return status;
     api::Expected<api::Scene> read = load_scene_argument(args.scene, args.overrides);
@@ -499,24 +500,6 @@ int run_render(const RenderArguments& args) {
     }
 }
 
-/// A usage error, before any work, when `target` cannot be written: its directory is missing or
-/// it is a directory itself. (The atomic writers refuse a directory in the way too, before they
-/// replace anything, for one that appears meanwhile.)
-void refuse_unwritable(const std::filesystem::path& target) {
-    const std::filesystem::path dir = target.parent_path().empty() ? "." : target.parent_path();
-    std::error_code error;
-    if (!std::filesystem::is_directory(dir, error))
-        throw std::invalid_argument("cannot write '" + target.string() + "': directory '" + dir.string() +
-                                    "' does not exist");
-    if (std::filesystem::is_directory(target, error))
-        throw std::invalid_argument("cannot write '" + target.string() + "': it is a directory");
-    try {
-        refuse_special_target(target);  // never a device, FIFO or socket
-    } catch (const std::runtime_error& e) {
-        throw std::invalid_argument(e.what());
-    }
-}
-
 /// A usage error when writing `target` would replace `input`, a file the same command reads.
 void refuse_overwriting_input(const std::filesystem::path& target, const std::string& input) {
     std::error_code error;
@@ -538,14 +521,26 @@ int run_convert(const std::string& scene_path, const std::string& output) {
         // Usage errors before any work: where the file(s) cannot go.
         std::filesystem::path ini_path(output);
         ini_path.replace_extension(".ini");
-        refuse_unwritable(output);
         refuse_overwriting_input(output, scene_path);
+        check_can_write(output);
         if (!to_yaml) {
             pov::check_pov_file_name(output);
-            refuse_unwritable(ini_path), refuse_overwriting_input(ini_path, scene_path);
+            refuse_overwriting_input(ini_path, scene_path);
+            check_can_write(ini_path);
         }
+        refuse_symlink_target(output);
+        if (!to_yaml) refuse_symlink_target(ini_path);
+        const InputFilesNoted inputs;  // the scene, its meshes and MTL files, as they are read
         const SceneDescription description = parse_scene_file(scene_path);
-        validate_scene(description);  // refuse what Whitted itself would refuse
+        validate_scene(description);  // refuse what Whitted itself would refuse; reads the meshes
+        // An output that is a mesh or MTL file of the scene under another name (`mtllib
+        // out.ini`, a mesh named `mesh.pov`): refused before a byte is written.
+        for (const std::filesystem::path& target : {std::filesystem::path(output), ini_path}) {
+            if (to_yaml && target == ini_path) continue;
+            if (const std::string input = input_file_at(target.string()); !input.empty())
+                throw std::invalid_argument("cannot write '" + target.string() + "': it is " + input +
+                                            ", an input of the same command");
+        }
         if (to_yaml) {
             // Any scene Whitted reads (a course .xml file, say) in Whitted's own format.
             yaml::write_yaml_file(description, output);
@@ -601,7 +596,9 @@ int run_colour(bool list, const std::string& config, const std::string& write_co
     try {
         if (!config.empty() && !list) throw std::invalid_argument("--ocio-config goes with --list");
         if (!write_config.empty()) {
-            refuse_unwritable(write_config);  // before a byte is written; /dev/full stays a device
+            // Before a byte is written; /dev/full stays a device.
+            check_can_write(write_config);
+            refuse_symlink_target(write_config);
             const std::string text = DisplayTransform::builtin_config_text();
             write_files_atomically({{write_config, text}});
             std::fprintf(stderr, "whitted: wrote the built-in OpenColorIO config to %s\n", write_config.c_str());

@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <numbers>
 #include <random>
 #include <string>
@@ -430,6 +431,23 @@ TEST(ObjWild, AnMtlFileNamedAgainIsReadOnce) {
     ASSERT_EQ(mesh.materials.size(), 3u);  // red, green, blue: each once
     EXPECT_EQ(mesh.materials[size_t(mesh.triangle_material[0])].kd.value, (Color{0, 0, 1}));
     EXPECT_EQ(mesh.materials[size_t(mesh.triangle_material[1])].kd.value, (Color{0, 1, 0}));
+    EXPECT_TRUE(mesh.warnings.empty());
+}
+
+// The same file under other spellings (`./a.mtl`, `././a.mtl`, a link to it) is read once too: 50
+// spellings of one MTL file of 100,000 materials took 49.8 s and 3.46 GB.
+TEST(ObjWild, AnMtlFileSpelledManyWaysIsReadOnce) {
+    const test::ScratchDirectory directory;
+    directory.write("a.mtl", "newmtl red\nKd 1 0 0\nnewmtl green\nKd 0 1 0\n");
+    std::filesystem::create_directory(directory.path() / "sub");
+    std::filesystem::create_symlink("a.mtl", directory.path() / "link.mtl");
+    std::string text = "mtllib link.mtl\nmtllib sub/../a.mtl\n";
+    for (std::string spelling = "a.mtl"; spelling.size() < 200; spelling = "./" + spelling)
+        text += "mtllib " + spelling + "\n";
+    const std::string path = directory.write("many.obj", text + triangle_obj_body + "usemtl green\nf 1 2 3\n");
+    const MeshData mesh = load_obj_mesh(path, {});
+    ASSERT_EQ(mesh.materials.size(), 2u);  // red, green: once, not once per spelling
+    EXPECT_EQ(mesh.materials[size_t(mesh.triangle_material[0])].kd.value, (Color{0, 1, 0}));
     EXPECT_TRUE(mesh.warnings.empty());
 }
 

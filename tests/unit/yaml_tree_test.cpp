@@ -12,9 +12,15 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 namespace whitted::yaml_tree {
 namespace {
@@ -281,6 +287,62 @@ TEST(MappedTextFile, PagesLetGoLeaveTheProcessButTheTextStaysTheSame) {
     file.reader_at(file.text().size());
     EXPECT_LE(resident_file_kib(), after + 4 * 1024);
     EXPECT_EQ(file.text(), bytes);
+}
+
+// A mapped file truncated by another program while it is read: the reader reads zeros where the
+// cut pages were (never SIGBUS), and read() says the file changed, naming it.
+TEST(MappedTextFile, AFileTruncatedWhileReadIsAnErrorNamingItNeverSigbus) {
+    const test::ScratchDirectory dir;
+    const std::string path = dir.write("cut.obj", std::string(size_t(4) << 20, 'v'));
+    const MappedTextFile file(path, int64_t(1) << 30, "mesh file");
+    ASSERT_FALSE(file.changed());
+    ASSERT_EQ(::truncate(path.c_str(), 1000), 0);
+    std::atomic<size_t> seen{0};
+    try {
+        // Four threads at once, as the OBJ reader reads its parts; each meets cut pages.
+        file.read([&] {
+            std::vector<std::thread> threads;
+            const std::string_view text = file.text();
+            for (size_t part = 0; part < 4; ++part)
+                threads.emplace_back([&, part] {
+                    const std::string_view mine = text.substr(part * text.size() / 4, text.size() / 4);
+                    seen += size_t(std::count(mine.begin(), mine.end(), 'v'));
+                });
+            for (std::thread& thread : threads) thread.join();
+            return 0;
+        });
+        ADD_FAILURE() << "read() returned for a file truncated while it was read";
+    } catch (const FileChangedWhileRead& e) {
+        EXPECT_THAT(e.what(), ::testing::HasSubstr("the mesh file '" + path + "' changed while it was read"));
+        EXPECT_THAT(e.what(), ::testing::HasSubstr("4194304 bytes when opened, 1000 bytes now"));
+    }
+    EXPECT_EQ(seen.load(), 1000u);  // the rest read as zeros
+    EXPECT_TRUE(file.changed());
+}
+
+// An error the reader throws because of the zeros it met is the file's change, not bad input.
+TEST(MappedTextFile, AnErrorFromTheZerosOfACutFileBecomesTheChange) {
+    const test::ScratchDirectory dir;
+    const std::string path = dir.write("cut.yaml", std::string(size_t(1) << 20, 'a'));
+    const MappedTextFile file(path, int64_t(1) << 30, "scene file");
+    ASSERT_EQ(::truncate(path.c_str(), 10), 0);
+    EXPECT_THROW(file.read([&] {
+        check_text_is_readable(file.text(), path);  // a NUL byte at 1:11
+        return 0;
+    }),
+                 FileChangedWhileRead);
+}
+
+// The handler mends only its own mappings: any other SIGBUS still ends the process by it.
+TEST(MappedTextFileDeathTest, AnotherSigbusIsStillFatal) {
+    const test::ScratchDirectory dir;
+    const std::string path = dir.write("whole.yaml", "a: 1\n");
+    EXPECT_EXIT(
+        {
+            const MappedTextFile file(path, 1 << 20, "scene file");
+            ::raise(SIGBUS);
+        },
+        ::testing::KilledBySignal(SIGBUS), "");
 }
 
 TEST(YamlTree, TheFastScannerSaysWhereItIsAsItGoes) {

@@ -94,6 +94,12 @@ std::filesystem::path directory_of(const std::filesystem::path& target) {
     return target.parent_path().empty() ? "." : target.parent_path();
 }
 
+/// The mode a new file takes from the one it replaces: its permission bits (a private 0600
+/// output stays private), never set-user-ID, set-group-ID or sticky (an image is no program).
+mode_t kept_mode(mode_t replaced) {
+    return replaced & 0777;
+}
+
 /// A finished file moved to its target, and how to take that back.
 struct Moved {
     std::filesystem::path target;
@@ -106,8 +112,7 @@ Moved move_keeping_previous(const std::string& temporary, const std::filesystem:
     Moved moved{target, temporary};
     struct stat existing {};
     const bool exists = ::lstat(target.c_str(), &existing) == 0;
-    // The new file keeps the mode of the one it replaces (a private 0600 output stays private).
-    if (exists && S_ISREG(existing.st_mode)) ::chmod(temporary.c_str(), existing.st_mode & 07777);
+    if (exists && S_ISREG(existing.st_mode)) ::chmod(temporary.c_str(), kept_mode(existing.st_mode));
     if (exists && S_ISREG(existing.st_mode) &&
         ::renameat2(AT_FDCWD, temporary.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) == 0) {
         moved.exchanged = true;
@@ -179,6 +184,49 @@ void refuse_special_target(const std::filesystem::path& target) {
                                  "regular files and never replaces anything else");
 }
 
+void check_can_write(const std::filesystem::path& target) {
+    const std::filesystem::path directory = directory_of(target);
+    std::error_code error;
+    if (!std::filesystem::is_directory(directory, error))
+        throw std::invalid_argument("cannot write '" + target.string() + "': directory '" + directory.string() +
+                                    "' does not exist");
+    if (std::filesystem::is_directory(target, error))
+        throw std::invalid_argument("cannot write '" + target.string() + "': it is a directory");
+    try {
+        refuse_special_target(target);
+    } catch (const std::runtime_error& e) {
+        throw std::invalid_argument(e.what());
+    }
+    // A file made and dropped where the output will go. access(W_OK) is not enough: root passes
+    // it in an immutable (chattr +i) or read-only-mounted directory, where the write would fail.
+    const auto refuse = [&](int error_number) {
+        throw std::invalid_argument("cannot write '" + target.string() + "': cannot create a file in directory '" +
+                                    directory.string() + "': " + std::strerror(error_number));
+    };
+    int fd = ::open(directory.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0600);
+    if (fd >= 0) {
+        ::close(fd);  // unnamed: gone with its descriptor
+        return;
+    }
+    if (errno != EOPNOTSUPP && errno != EISDIR && errno != EINVAL) refuse(errno);
+    // No unnamed files on this filesystem: a named one, removed at once.
+    const std::string probe = temporary_path(target);
+    fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd < 0) refuse(errno);
+    ::close(fd);
+    ::unlink(probe.c_str());
+}
+
+void refuse_symlink_target(const std::filesystem::path& target) {
+    struct stat existing {};
+    if (::lstat(target.c_str(), &existing) != 0 || !S_ISLNK(existing.st_mode)) return;
+    std::error_code error;
+    const std::filesystem::path points_to = std::filesystem::read_symlink(target, error);
+    throw std::invalid_argument("cannot write '" + target.string() + "': it is a symbolic link" +
+                                (error ? std::string() : " to '" + points_to.string() + "'") +
+                                "; Whitted neither writes through a link nor replaces it: name the file itself");
+}
+
 void move_into_place(const std::string& temporary, const std::filesystem::path& target) {
     refuse_special_target(target);
     remove_abandoned_temporaries(target);
@@ -189,7 +237,7 @@ void move_into_place(const std::string& temporary, const std::filesystem::path& 
     // directory), or a filesystem that cannot exchange: a plain rename, with its refusals.
     struct stat existing {};
     const bool regular = ::lstat(target.c_str(), &existing) == 0 && S_ISREG(existing.st_mode);
-    if (regular) ::chmod(temporary.c_str(), existing.st_mode & 07777);  // keeps a 0600 output private
+    if (regular) ::chmod(temporary.c_str(), kept_mode(existing.st_mode));
     if (regular && ::renameat2(AT_FDCWD, temporary.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) == 0) {
         std::remove(temporary.c_str());  // the old file
         return;

@@ -31,6 +31,18 @@ std::string temporary_path(const std::filesystem::path& target);
 /// Throws std::runtime_error when `target` exists and is neither a regular file nor a directory
 /// (a device such as /dev/full, a FIFO, a socket, or a link to one): an output never replaces it.
 void refuse_special_target(const std::filesystem::path& target);
+
+/// The usage checks of an output path, made before any work; each throws std::invalid_argument
+/// naming `target`: its directory exists and a file can be made in it (a file is made there and
+/// removed: a read-only, immutable or full directory is found now, not after minutes of work),
+/// `target` is not a directory, and not a device, FIFO or socket (refuse_special_target).
+void check_can_write(const std::filesystem::path& target);
+
+/// A usage error (std::invalid_argument) when `target` is a symbolic link. An output replaces a
+/// regular file by renaming over it, which would replace the link itself, not what it names;
+/// writing through it instead could reach anything (`/proc/self/fd/1` names whatever the
+/// standard output is). So neither: the user names the file itself.
+void refuse_symlink_target(const std::filesystem::path& target);
 void move_into_place(const std::string& temporary, const std::filesystem::path& target);
 
 void write_files_atomically(const std::vector<std::pair<std::filesystem::path, std::string_view>>& files);

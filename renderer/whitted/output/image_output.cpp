@@ -71,18 +71,7 @@ void check_output_path(const std::string& path) {
     output_kind(path);
     const std::filesystem::path p(path);
     const std::filesystem::path dir = p.parent_path().empty() ? "." : p.parent_path();
-    std::error_code error;
-    if (!std::filesystem::is_directory(dir, error))
-        throw std::invalid_argument("cannot write '" + path + "': directory '" + dir.string() + "' does not exist");
-    if (::access(dir.c_str(), W_OK) != 0)
-        throw std::invalid_argument("cannot write '" + path + "': directory '" + dir.string() + "' is not writable");
-    if (std::filesystem::is_directory(p, error))
-        throw std::invalid_argument("cannot write '" + path + "': it is a directory");
-    try {
-        refuse_special_target(p);
-    } catch (const std::runtime_error& e) {
-        throw std::invalid_argument(e.what());  // a usage error, before any work
-    }
+    check_can_write(p);
     // Found here rather than when the finished image cannot be named, after the render.
     const long name_max = ::pathconf(dir.c_str(), _PC_NAME_MAX);
     const size_t longest = name_max > 0 ? size_t(name_max) : size_t(NAME_MAX);

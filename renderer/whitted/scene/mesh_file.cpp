@@ -16,6 +16,8 @@
 
 #include "whitted/scene/text_checks.h"
 
+#include <sys/stat.h>
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -30,10 +32,12 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string_view>
 #include <unordered_map>
 #include <unordered_set>
+#include <utility>
 
 namespace whitted {
 namespace {
@@ -771,11 +775,16 @@ void resolve_materials(const std::string& path, ObjContents& contents) {
     std::unordered_map<std::string, int32_t> by_name;
     std::vector<const MtlFile*> missing;
     std::string read_names;  // "a.mtl, b.mtl" for messages
+    // One file under many spellings (`./a.mtl`, `././a.mtl`, a link) is read once, as one name
+    // on many lines is: by its identity, not its name.
+    std::set<std::pair<dev_t, ino_t>> files_read;
     for (const MtlFile& mtl : contents.mtl_files) {
         if (!mtl.exists) {
             missing.push_back(&mtl);
             continue;
         }
+        struct stat info {};
+        if (::stat(mtl.path.c_str(), &info) == 0 && !files_read.insert({info.st_dev, info.st_ino}).second) continue;
         read_mtl(mtl.path, mesh.materials, by_name, mesh.warnings);
         read_names += (read_names.empty() ? "" : ", ") + quote_name(mtl.name);
     }
@@ -1156,35 +1165,38 @@ MeshData load_obj_mesh(const std::string& path, const SourceLocation& referenced
     if (!std::filesystem::is_regular_file(status))
         throw InputError(referenced_at, "mesh file '" + path + "' is not a regular file");
     const MappedTextFile file(path, limits::max_mesh_file_bytes, "mesh file");
-    const std::string_view text = without_byte_order_mark(file.text(), path);
-    // Large files are read by every core at once, a run of lines each (below a few megabytes
-    // the threads would cost more than they save).
-    if (parts <= 0) {
-        constexpr size_t bytes_per_part = size_t(4) << 20;
-        parts = int(std::clamp<size_t>(text.size() / bytes_per_part, 1,
-                                       size_t(std::max(1, tbb::this_task_arena::max_concurrency()))));
-    }
-    std::optional<ObjContents> contents;
-    if (parts > 1) contents = read_obj(path, text, size_t(parts));
-    if (!contents) contents = read_obj(path, text, 1);
-    MeshData& mesh = contents->mesh;
-    if (mesh.indices.empty()) {
-        std::string why;
-        if (text.find_first_not_of(" \t\r\n\v\f") == std::string_view::npos)
-            why = text.empty() ? ": the file is empty" : ": the file is blank";
-        else if (contents->lines_and_points > 0)
-            why = ": its " + count_of(int64_t(contents->lines_and_points), "line (l) or point (p) statement") +
-                  (contents->lines_and_points == 1 ? " is" : " are") + " not drawn (Whitted renders faces, f)";
-        else if (!mesh.positions.empty())
-            why = ": only vertices (v), no f statements";
-        throw InputError(referenced_at, "mesh file '" + path + "' has no faces" + why);
-    }
-    if (need_materials) {
-        resolve_materials(path, *contents);
-    } else {
-        std::fill(mesh.triangle_material.begin(), mesh.triangle_material.end(), -1);
-    }
-    return std::move(mesh);
+    // Through read(): a file truncated while the parts are read is an error, never SIGBUS.
+    return file.read([&]() -> MeshData {
+        const std::string_view text = without_byte_order_mark(file.text(), path);
+        // Large files are read by every core at once, a run of lines each (below a few megabytes
+        // the threads would cost more than they save).
+        if (parts <= 0) {
+            constexpr size_t bytes_per_part = size_t(4) << 20;
+            parts = int(std::clamp<size_t>(text.size() / bytes_per_part, 1,
+                                           size_t(std::max(1, tbb::this_task_arena::max_concurrency()))));
+        }
+        std::optional<ObjContents> contents;
+        if (parts > 1) contents = read_obj(path, text, size_t(parts));
+        if (!contents) contents = read_obj(path, text, 1);
+        MeshData& mesh = contents->mesh;
+        if (mesh.indices.empty()) {
+            std::string why;
+            if (text.find_first_not_of(" \t\r\n\v\f") == std::string_view::npos)
+                why = text.empty() ? ": the file is empty" : ": the file is blank";
+            else if (contents->lines_and_points > 0)
+                why = ": its " + count_of(int64_t(contents->lines_and_points), "line (l) or point (p) statement") +
+                      (contents->lines_and_points == 1 ? " is" : " are") + " not drawn (Whitted renders faces, f)";
+            else if (!mesh.positions.empty())
+                why = ": only vertices (v), no f statements";
+            throw InputError(referenced_at, "mesh file '" + path + "' has no faces" + why);
+        }
+        if (need_materials) {
+            resolve_materials(path, *contents);
+        } else {
+            std::fill(mesh.triangle_material.begin(), mesh.triangle_material.end(), -1);
+        }
+        return std::move(mesh);
+    });
 }
 
 void print_mesh_warnings(const MeshData& mesh) {

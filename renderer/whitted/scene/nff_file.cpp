@@ -434,7 +434,7 @@ SceneDescription parse_nff_text(std::string_view text, const std::string& path, 
 SceneDescription parse_nff_file(const std::string& path, const ObjectSink* sink) {
     // NFF files are mesh-sized (SPD's larger sizes are hundreds of megabytes): the mesh limit.
     const MappedTextFile file(path, limits::max_mesh_file_bytes, "NFF scene file");
-    return parse_nff_text(file.text(), path, sink);
+    return file.read([&] { return parse_nff_text(file.text(), path, sink); });
 }
 
 }  // namespace whitted

@@ -837,7 +837,8 @@ SceneDescription parse_scene_file(const std::string& path, const ObjectSink* sin
     // from it points back into it: the pages behind the reader are let go as it goes, so that a
     // large scene file does not add its size to the peak memory.
     MappedTextFile file(path, limits::max_scene_file_bytes, "scene file");
-    return parse_text(file.text(), path, sink, [&file](size_t offset) { file.reader_at(offset); });
+    return file.read(
+        [&] { return parse_text(file.text(), path, sink, [&file](size_t offset) { file.reader_at(offset); }); });
 }
 
 }  // namespace whitted

@@ -4,21 +4,127 @@
 #include "whitted/scene/source_location.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
+#include <string>
+#include <vector>
 
 namespace whitted {
+namespace {
+
+/// The mappings of MappedTextFile that the SIGBUS handler may mend: [begin, end) in whole pages.
+/// Lock-free atomics only, so that the handler can read them at any moment.
+struct GuardedMapping {
+    std::atomic<bool> taken{false};
+    std::atomic<uintptr_t> begin{0}, end{0};  ///< begin 0: no mapping
+    std::atomic<bool> cut{false};             ///< a page of it was past the file's end
+};
+constexpr int guarded_mappings = 64;  // files mapped at once; more are read with read() instead
+GuardedMapping g_guarded[guarded_mappings];
+struct sigaction g_previous_sigbus {};
+uintptr_t g_page_size = 4096;
+
+/// A read of a mapped file's page that the file no longer has (it was truncated) raises SIGBUS.
+/// When the page is one of ours, zeros are mapped from it to the mapping's end and the read
+/// goes on; the reader learns of the cut through MappedTextFile::changed(). mmap is a plain
+/// system call, safe here though POSIX does not list it. Any other SIGBUS: the handler that was
+/// there before is put back and the fault happens again (or the signal is raised again) under it.
+void on_sigbus(int, siginfo_t* info, void*) {
+    const auto address = reinterpret_cast<uintptr_t>(info->si_addr);
+    if (info->si_code > 0) {  // a fault, not a signal someone sent
+        for (GuardedMapping& mapping : g_guarded) {
+            const uintptr_t begin = mapping.begin.load(std::memory_order_acquire);
+            const uintptr_t end = mapping.end.load(std::memory_order_acquire);
+            if (begin == 0 || address < begin || address >= end) continue;
+            const uintptr_t page = address & ~(g_page_size - 1);
+            if (::mmap(reinterpret_cast<void*>(page), end - page, PROT_READ, MAP_PRIVATE | MAP_ANONYMOUS | MAP_FIXED,
+                       -1, 0) == MAP_FAILED)
+                break;
+            mapping.cut.store(true, std::memory_order_release);
+            return;
+        }
+    }
+    ::sigaction(SIGBUS, &g_previous_sigbus, nullptr);
+    if (info->si_code <= 0) ::raise(SIGBUS);
+}
+
+/// A slot for a mapping of `length` bytes at `address`, or -1 when all are taken.
+int guard_mapping(void* address, size_t length) {
+    static std::once_flag installed;
+    std::call_once(installed, [] {
+        g_page_size = uintptr_t(::sysconf(_SC_PAGESIZE));
+        struct sigaction action {};
+        action.sa_sigaction = on_sigbus;
+        action.sa_flags = SA_SIGINFO | SA_RESTART;
+        sigemptyset(&action.sa_mask);
+        ::sigaction(SIGBUS, &action, &g_previous_sigbus);
+    });
+    for (int slot = 0; slot < guarded_mappings; ++slot) {
+        if (g_guarded[slot].taken.exchange(true)) continue;
+        const auto begin = reinterpret_cast<uintptr_t>(address);
+        g_guarded[slot].cut.store(false);
+        g_guarded[slot].end.store((begin + length + g_page_size - 1) & ~(g_page_size - 1), std::memory_order_release);
+        g_guarded[slot].begin.store(begin, std::memory_order_release);
+        return slot;
+    }
+    return -1;
+}
+
+void release_mapping(int slot) {
+    g_guarded[slot].begin.store(0, std::memory_order_release);
+    g_guarded[slot].end.store(0, std::memory_order_release);
+    g_guarded[slot].taken.store(false);
+}
+
+/// The files read while an InputFilesNoted lives.
+struct NotedInput {
+    dev_t device;
+    ino_t inode;
+    std::string what;  ///< "the mesh file 'm.obj'"
+};
+std::mutex g_noted_mutex;
+int g_noting = 0;
+std::vector<NotedInput> g_noted;
+
+void note_input(const struct stat& info, const std::string& path, const std::string& what) {
+    const std::lock_guard<std::mutex> lock(g_noted_mutex);
+    if (g_noting > 0) g_noted.push_back({info.st_dev, info.st_ino, "the " + what + " '" + path + "'"});
+}
+
+}  // namespace
+
+InputFilesNoted::InputFilesNoted() {
+    const std::lock_guard<std::mutex> lock(g_noted_mutex);
+    ++g_noting;
+}
+
+InputFilesNoted::~InputFilesNoted() {
+    const std::lock_guard<std::mutex> lock(g_noted_mutex);
+    if (--g_noting == 0) g_noted.clear();
+}
+
+std::string input_file_at(const std::string& target) {
+    struct stat info {};
+    if (::stat(target.c_str(), &info) != 0) return {};
+    const std::lock_guard<std::mutex> lock(g_noted_mutex);
+    for (const NotedInput& input : g_noted)
+        if (input.device == info.st_dev && input.inode == info.st_ino) return input.what;
+    return {};
+}
 
 std::string read_text_file(const std::string& path, int64_t max_bytes, const std::string& what) {
     const MappedTextFile file(path, max_bytes, what);
-    return std::string(file.text());
+    return file.read([&] { return std::string(file.text()); });
 }
 
 bool is_plain_ascii(std::string_view text) {
@@ -141,6 +247,10 @@ MappedTextFile::MappedTextFile(const std::string& path, int64_t max_bytes, const
         throw InputError(
             {path}, what + " is " + std::to_string(info.st_size) + " bytes; the limit is " + std::to_string(max_bytes));
     }
+    note_input(info, path, what);
+    m_path = path;
+    m_what = what;
+    m_fd = fd;
     m_length = size_t(info.st_size);
     if (m_length > 0) {
         m_address = ::mmap(nullptr, m_length, PROT_READ, MAP_PRIVATE, fd, 0);
@@ -150,10 +260,48 @@ MappedTextFile::MappedTextFile(const std::string& path, int64_t max_bytes, const
             ::close(fd);
             throw InputError({path}, "cannot read the " + what + ": " + std::strerror(mmap_errno));
         }
+        m_guard = guard_mapping(m_address, m_length);
+        if (m_guard < 0) {
+            // Every slot taken (64 files mapped at once): this one is copied instead.
+            ::munmap(m_address, m_length);
+            m_address = nullptr;
+            m_copy.resize(m_length);
+            size_t done = 0;
+            while (done < m_length) {
+                const ssize_t got = ::pread(fd, m_copy.data() + done, m_length - done, off_t(done));
+                if (got < 0 && errno == EINTR) continue;
+                if (got < 0) {
+                    const int read_errno = errno;
+                    ::close(fd);
+                    throw InputError({path}, "cannot read the " + what + ": " + std::strerror(read_errno));
+                }
+                if (got == 0) {
+                    ::close(fd);
+                    m_fd = -1;
+                    throw_changed();
+                }
+                done += size_t(got);
+            }
+            m_text = m_copy;
+            return;
+        }
         ::madvise(m_address, m_length, MADV_WILLNEED);  // read ahead (the kernel's page cache)
         m_text = std::string_view(static_cast<const char*>(m_address), m_length);
     }
-    ::close(fd);
+}
+
+bool MappedTextFile::changed() const {
+    if (m_guard >= 0 && g_guarded[m_guard].cut.load(std::memory_order_acquire)) return true;
+    struct stat info {};
+    return m_fd >= 0 && ::fstat(m_fd, &info) == 0 && size_t(info.st_size) != m_length;
+}
+
+void MappedTextFile::throw_changed() const {
+    struct stat info {};
+    const std::string now = m_fd >= 0 && ::fstat(m_fd, &info) == 0 ? std::to_string(info.st_size) + " bytes" : "?";
+    throw FileChangedWhileRead("the " + m_what + " '" + m_path + "' changed while it was read (" +
+                               std::to_string(m_length) + " bytes when opened, " + now +
+                               " now): another program is writing or truncating it; nothing from it was used");
 }
 
 void MappedTextFile::reader_at(size_t offset) {
@@ -173,7 +321,9 @@ void MappedTextFile::reader_at(size_t offset) {
 }
 
 MappedTextFile::~MappedTextFile() {
+    if (m_guard >= 0) release_mapping(m_guard);
     if (m_address) ::munmap(m_address, m_length);
+    if (m_fd >= 0) ::close(m_fd);
 }
 
 }  // namespace whitted

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -26,8 +27,22 @@ using DoneBefore = std::function<void(size_t offset)>;
 /// the check is, every MappedTextFile::reader_stride bytes of plain ASCII text.
 void check_text_is_readable(std::string_view text, const std::string& path, const DoneBefore& done_before = {});
 
+/// An input file that was cut short (truncated) or grown while it was read: whatever was read
+/// from it is not the file. Not an InputError: the file may be fine; it changed under the reader
+/// (a failure, exit 1). The message names the file.
+class FileChangedWhileRead : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
 /// A file mapped into memory, read-only (mesh files are tens of megabytes: no copy, no zeroed
 /// buffer). Throws InputError like read_text_file.
+///
+/// A mapped file that another process truncates would kill the reader with SIGBUS at the first
+/// byte past the new end. A SIGBUS handler knows every mapping made here: it puts zeros where
+/// the cut pages were (the read goes on, reading zeros) and notes the cut; read() then throws
+/// FileChangedWhileRead instead of returning what was read. A SIGBUS anywhere else is handled
+/// as it was before. Every reader of text() must go through read().
 class MappedTextFile {
 public:
     MappedTextFile(const std::string& path, int64_t max_bytes, const std::string& what);
@@ -35,6 +50,25 @@ public:
     MappedTextFile(const MappedTextFile&) = delete;
     MappedTextFile& operator=(const MappedTextFile&) = delete;
     std::string_view text() const { return m_text; }
+    /// True when the file was cut while mapped (its pages read as zeros since) or is no longer
+    /// the size it was when mapped.
+    bool changed() const;
+    /// Runs `reader` (which reads text()) and returns what it returns, unless the file changed
+    /// meanwhile: then FileChangedWhileRead, also in place of an error the reader threw (the
+    /// zeros it met, say, are not the file's fault).
+    template <class Reader>
+    auto read(Reader&& reader) const -> decltype(reader()) {
+        try {
+            auto result = reader();
+            if (changed()) throw_changed();
+            return result;
+        } catch (const FileChangedWhileRead&) {
+            throw;
+        } catch (...) {
+            if (changed()) throw_changed();
+            throw;
+        }
+    }
     /// A reader going through the text once is at `offset`: the whole pages before it leave
     /// this process's memory, and the next `reader_stride` bytes are mapped in, in one call
     /// rather than a page fault every few pages. The text stays the same: the pages let go are
@@ -47,11 +81,33 @@ public:
     static constexpr size_t reader_stride = size_t(8) << 20;
 
 private:
+    [[noreturn]] void throw_changed() const;
+    std::string m_path, m_what;
     std::string_view m_text;
     void* m_address = nullptr;
     size_t m_length = 0;
+    int m_fd = -1;        ///< kept open: the size is checked on it after the read
+    int m_guard = -1;     ///< the SIGBUS handler's slot for this mapping
+    std::string m_copy;   ///< the text, read with read(), when every slot is taken
     size_t m_let_go = 0;  ///< bytes from the start let go by the latest reader (whole pages)
 };
+
+/// While one lives, every file opened by MappedTextFile (read_text_file too: scenes, meshes, MTL
+/// and NFF files) is noted by its identity (device and inode), so that a command about to write
+/// can ask whether an output is one of its own inputs under another name (input_file_at). A
+/// command (`convert`, `check`) makes one; a library user's process, which may well rewrite a
+/// file it read earlier, makes none.
+class InputFilesNoted {
+public:
+    InputFilesNoted();
+    ~InputFilesNoted();
+    InputFilesNoted(const InputFilesNoted&) = delete;
+    InputFilesNoted& operator=(const InputFilesNoted&) = delete;
+};
+
+/// What `target` is among the files read while an InputFilesNoted lives ("the mesh file
+/// 'm.obj'"), or "" when it is none of them or does not exist.
+std::string input_file_at(const std::string& target);
 
 /// `text` made safe to print in a message: control characters (C0 such as ESC and BEL, DEL, and
 /// C1 such as U+009B) and bytes that are not UTF-8 (Latin-1 names) written as \xNN escapes, so a
