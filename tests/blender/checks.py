@@ -1,5 +1,5 @@
 # Run inside `blender -b --factory-startup --python tests/blender/checks.py -- MODE OUTDIR`,
-# MODE one of errors, cancel, check_pov. Writes OUTDIR/result.json for the driver to assert on.
+# MODE one of errors, cancel, check_pov, exposure. Writes OUTDIR/result.json for the driver to assert on.
 import json, math, os, sys, time, bpy
 mode, out = sys.argv[sys.argv.index("--") + 1:][:2]
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "plugins", "blender"))
@@ -88,5 +88,78 @@ elif mode == 'check_pov':
     res.update(passed=passed, verdict=verdict, path=path, exists=os.path.exists(path),
                report=report, report_files=sorted(os.listdir(report)) if os.path.isdir(report) else None,
                note=sc.render.stamp_note_text, use_stamp_note=sc.render.use_stamp_note)
+elif mode == 'exposure':
+    import numpy as np
+
+    def render(engine, name):
+        """Render the scene with `engine`; the float result (rows from the top), straight from
+        a 32-bit EXR (no view transform: Standard, and EXR is scene-referred)."""
+        sc.render.engine = engine
+        t = time.monotonic()
+        bpy.ops.render.render()
+        res[name + '_seconds'] = time.monotonic() - t
+        s = sc.render.image_settings
+        s.file_format, s.color_depth = 'OPEN_EXR', '32'
+        path = os.path.join(out, name + '.exr')
+        bpy.data.images["Render Result"].save_render(path)
+        img = bpy.data.images.load(path)
+        return np.array(img.pixels[:]).reshape(img.size[1], img.size[0], 4)[::-1]
+
+    def cube_stats(name):
+        """The factory scene at 10 % (192x108): Cycles (16 samples, no denoiser, transparent film
+        so its alpha marks the cube) and Whitted; the mean of the cube's pixels in each."""
+        c = render('CYCLES', name + '_cycles')
+        w = render('WHITTED', name + '_whitted')
+        cube = c[:, :, 3] > 0.999
+        res[name] = dict(pixels=int(cube.sum()), cycles_mean=float(c[cube][:, :3].mean()),
+                         whitted_mean=float(w[cube][:, :3].mean()),
+                         clipped=float((w[cube][:, :3] >= 1.0).any(axis=1).mean()),
+                         lights=json.loads(E.last_scene_text)['lights'])
+
+    sc.render.resolution_percentage = 10
+    sc.render.film_transparent = True
+    sc.cycles.samples, sc.cycles.use_denoising, sc.cycles.seed = 16, False, 0
+    cube_stats('factory')
+    # Direct light only: no World light in Cycles, no ambient in Whitted
+    background = sc.world.node_tree.nodes['Background'].inputs['Strength']
+    background.default_value = 0.0
+    sc.whitted.ambient = (0.0, 0.0, 0.0)
+    cube_stats('direct')
+    res['light'] = dict(location=list(bpy.data.objects['Light'].location), energy=bpy.data.lights['Light'].energy)
+    # The derivation's premise: a white Lambertian plane (Diffuse BSDF; Whitted kd 1) seen head
+    # on, a point light of P W at d straight above, then a sun of strength S straight down.
+    bpy.data.objects.remove(bpy.data.objects['Cube'])
+    bpy.data.objects.remove(bpy.data.objects['Light'])
+    bpy.ops.mesh.primitive_plane_add(size=2)
+    m = bpy.data.materials.new("lambert")
+    m.use_nodes = True
+    nodes = m.node_tree.nodes
+    nodes.remove(nodes['Principled BSDF'])
+    diffuse = nodes.new('ShaderNodeBsdfDiffuse')
+    diffuse.inputs['Color'].default_value = (1, 1, 1, 1)
+    m.node_tree.links.new(diffuse.outputs[0], nodes['Material Output'].inputs['Surface'])
+    m.whitted.use_whitted = True
+    m.whitted.ka, m.whitted.kd, m.whitted.ks = (0, 0, 0), (1, 1, 1), (0, 0, 0)
+    bpy.context.object.data.materials.append(m)
+    cam = sc.camera
+    cam.location, cam.rotation_euler = (0, 0, 5), (0, 0, 0)
+    cam.data.type, cam.data.ortho_scale = 'ORTHO', 0.1
+    sc.render.resolution_x = sc.render.resolution_y = 16
+    sc.render.resolution_percentage = 100
+    sc.render.film_transparent = False
+    for kind, energy in (('POINT', 100.0), ('SUN', 2.0)):
+        bpy.ops.object.light_add(type=kind, location=(0, 0, 2))
+        light = bpy.context.object
+        light.data.energy = energy
+        if kind == 'POINT':
+            light.data.shadow_soft_size = 0.0
+        else:
+            light.data.angle = 0.0
+        res['plane_' + kind] = dict(
+            energy=energy, height=2.0,
+            cycles=float(render('CYCLES', 'plane_cycles')[:, :, :3].mean()),
+            whitted=float(render('WHITTED', 'plane_whitted')[:, :, :3].mean()),
+            intensity=json.loads(E.last_scene_text)['lights'][0]['intensity'])
+        bpy.data.objects.remove(light)
 with open(os.path.join(out, "result.json"), "w") as f:
     json.dump(res, f, indent=1)

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""ctest blender.errors / blender.cancel / blender.check_pov: run tests/blender/checks.py MODE in
+"""ctest blender.errors / blender.cancel / blender.check_pov / blender.exposure: run tests/blender/checks.py MODE in
 headless Blender and assert on what it recorded. Usage: test_checks.py MODE"""
 import json, math, os, shutil, subprocess, sys, tempfile
 mode = sys.argv[1]
@@ -50,5 +50,33 @@ elif mode == "check_pov":
     assert res["use_stamp_note"] and note.startswith("whitted check: PASS"), note
     assert "% of pixels within tolerance" in note and "PSNR" in note and res["report"] in note, note
     print(f"blender.check_pov: {res['verdict']}; stamp note: {note}")
+elif mode == "exposure":
+    # docs/blender.md, Mapping: a point light of P W -> I = P/(4 pi^2 d_ref^2), d_ref = the
+    # distance to the geometry's bounding-box centre; a sun of S W/m^2 -> I = S/pi.
+    def near(a, b, rel):
+        return abs(a - b) <= rel * abs(b)
+    for kind, expect in (("POINT", lambda e, h: e / (4 * math.pi ** 2 * h ** 2)),
+                         ("SUN", lambda e, h: e / math.pi)):
+        p = res["plane_" + kind]
+        radiance = expect(p["energy"], p["height"])  # white Lambertian plane, head on
+        assert near(p["cycles"], radiance, 0.02), (kind, "Cycles does not give the derivation's radiance", p, radiance)
+        assert all(near(i, radiance, 1e-6) for i in p["intensity"]), (kind, p, radiance)
+        assert near(p["whitted"], radiance, 0.01), (kind, p, radiance)
+    light = res["light"]
+    d_ref = math.dist(light["location"], (0, 0, 0))  # the default cube spans [-1, 1]^3
+    i_expect = light["energy"] / (4 * math.pi ** 2 * d_ref ** 2)
+    for case, factor in (("factory", 1.6), ("direct", 1.5)):
+        c = res[case]
+        assert c["pixels"] > 1000, c  # the cube covers part of the 192x108 frame
+        assert all(near(i, i_expect, 1e-6) for i in c["lights"][0]["intensity"]), (c["lights"], i_expect)
+        assert c["clipped"] < 0.01, f"{case}: {100 * c['clipped']:.1f}% of the cube's pixels clipped"
+        ratio = c["cycles_mean"] / c["whitted_mean"]
+        assert 1 / factor <= ratio <= factor, f"{case}: Cycles/Whitted {ratio:.3f} not within {factor}"
+    print("blender.exposure: " + "; ".join(
+        f"{k}: cube mean Cycles {res[k]['cycles_mean']:.4f} Whitted {res[k]['whitted_mean']:.4f} "
+        f"(ratio {res[k]['cycles_mean'] / res[k]['whitted_mean']:.3f}), {100 * res[k]['clipped']:.2f}% clipped"
+        for k in ("factory", "direct")) + "; white plane: " + "; ".join(
+        f"{k} Cycles {res['plane_' + k]['cycles']:.4f} Whitted {res['plane_' + k]['whitted']:.4f}"
+        for k in ("POINT", "SUN")) + f"; Cycles took {res['factory_cycles_seconds']:.1f} s")
 else:
     sys.exit(f"unknown mode {mode}")

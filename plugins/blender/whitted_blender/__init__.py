@@ -16,18 +16,14 @@ import tempfile
 import bpy
 import numpy as np
 
+from .locate import ModuleNotFound, import_whitted
 from .mapping import MappingError, dumps
 
 
 def _whitted():
-    """Import the `whitted` module; WHITTED_PYTHONPATH is searched first (why: build trees)."""
-    extra = os.environ.get("WHITTED_PYTHONPATH")
-    if extra:
-        for p in reversed(extra.split(os.pathsep)):
-            if p and p not in sys.path:
-                sys.path.insert(0, p)
-    import whitted
-    return whitted
+    """The `whitted` module (locate.py: WHITTED_PYTHONPATH, sys.path, then near the add-on);
+    raises locate.ModuleNotFound naming every folder searched."""
+    return import_whitted(__file__)
 
 
 def scene_text(depsgraph):
@@ -92,7 +88,10 @@ class WhittedRenderEngine(bpy.types.RenderEngine):
             WhittedRenderEngine.last_error = str(e)
             self.report({'ERROR'}, str(e))
             return
-        except Exception as e:  # whitted.Error or ImportError: a message, not a traceback
+        except ModuleNotFound as e:  # its message names the folders searched and what to set
+            self.report({'ERROR'}, str(e))
+            return
+        except Exception as e:  # whitted.Error: a message, not a traceback
             self.report({'ERROR'}, f"Whitted: {e}")
             return
         width, height = scene.width, scene.height
@@ -195,6 +194,9 @@ class WHITTED_OT_check_pov(bpy.types.Operator):
     def execute(self, context):
         try:
             passed, verdict, path, report = check_pov(context)
+        except (ModuleNotFound, MappingError) as e:  # their messages say "Whitted: ..." already
+            self.report({'ERROR'}, str(e))
+            return {'CANCELLED'}
         except Exception as e:
             self.report({'ERROR'}, f"Whitted: {e}")
             return {'CANCELLED'}
@@ -224,6 +226,33 @@ class WHITTED_PT_material(WhittedPanel, bpy.types.Panel):
             self.layout.prop(p, k)
 
 
+def draw_module_status(layout):
+    """Where the `whitted` module was found or, when it was not, every folder searched and what
+    to do (the same text F12 reports), one label per line: Blender's labels do not wrap."""
+    try:
+        m = _whitted()
+    except ModuleNotFound as e:
+        box = layout.box()
+        for i, line in enumerate(str(e).split("\n")):
+            if line.startswith("Looked in ") and ": " in line:
+                what, folders = line.split(": ", 1)
+                box.label(text=what + ":")
+                for f in folders.rstrip(".").split(", "):
+                    box.label(text="    " + f)
+            else:
+                box.label(text=line, icon='ERROR' if i == 0 else 'NONE')
+        return False
+    layout.label(text=f"whitted module: {getattr(m, '__file__', m.__name__)}", icon='CHECKMARK')
+    return True
+
+
+class WhittedAddonPreferences(bpy.types.AddonPreferences):
+    bl_idname = __package__
+
+    def draw(self, context):
+        draw_module_status(self.layout)
+
+
 class WHITTED_PT_render(WhittedPanel, bpy.types.Panel):
     bl_context = "render"
 
@@ -232,6 +261,8 @@ class WHITTED_PT_render(WhittedPanel, bpy.types.Panel):
         return context.engine == "WHITTED"
 
     def draw(self, context):
+        if "whitted" not in sys.modules:  # only say something when it is wrong
+            draw_module_status(self.layout)
         p = context.scene.whitted
         for k in ("samples", "max_depth", "ambient", "threads"):
             self.layout.prop(p, k)
@@ -273,7 +304,7 @@ def _menu_export(self, context):
     self.layout.operator(EXPORT_SCENE_OT_whitted.bl_idname, text="Whitted scene (.json)")
 
 
-_classes = (WhittedSceneProps, WhittedMaterialProps, WhittedLightProps, WhittedRenderEngine,
+_classes = (WhittedAddonPreferences, WhittedSceneProps, WhittedMaterialProps, WhittedLightProps, WhittedRenderEngine,
             EXPORT_SCENE_OT_whitted, WHITTED_OT_check_pov, WHITTED_PT_material, WHITTED_PT_render, WHITTED_PT_light)
 
 

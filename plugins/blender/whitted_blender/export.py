@@ -4,7 +4,8 @@ import math
 import mathutils
 import numpy as np
 
-from .mapping import MappingError, horizontal_fov, principled_to_lecture
+from .mapping import (MappingError, horizontal_fov, point_intensity, principled_to_lecture,
+                      reference_distance, sun_intensity)
 
 
 def _matrix_rows(m):
@@ -109,22 +110,14 @@ def describe(depsgraph):
             'image': {'width': width, 'height': height, 'samples': props.samples, 'background': bg},
             'render': {'max_depth': props.max_depth}, 'ambient': list(props.ambient),
             'lights': [], 'materials': {}, 'prototypes': {}, 'objects': []}
+    lights = []
+    box_lo = [math.inf] * 3
+    box_hi = [-math.inf] * 3
     for inst in depsgraph.object_instances:
         ob = inst.object
         if ob.type == 'LIGHT':
-            light = ob.data
-            lp = light.whitted
-            # A point light's watts spread over the sphere; a sun's strength is already irradiance.
-            scale = light.energy / (4 * math.pi) if light.type == 'POINT' else light.energy
-            colour = list(lp.intensity) if lp.use_intensity else [scale * c for c in light.color]
-            if light.type == 'POINT':
-                desc['lights'].append({'type': 'point', 'position': list(inst.matrix_world.translation),
-                                       'intensity': colour})
-            elif light.type == 'SUN':
-                d = inst.matrix_world.to_3x3() @ mathutils.Vector((0, 0, -1))
-                desc['lights'].append({'type': 'directional', 'direction': list(d), 'intensity': colour})
-            else:
-                raise MappingError(f"Whitted: light '{ob.name}' of type {light.type} is not supported")
+            # After the loop: a point light's exposure needs the bounds of all the geometry.
+            lights.append((ob, inst.matrix_world.copy()))
         elif ob.type in {'MESH', 'CURVE', 'SURFACE', 'META', 'FONT'}:
             # Prototype key: the evaluated mesh. Objects without modifiers that share a mesh
             # datablock (linked duplicates, collection instances of one object) evaluate to
@@ -144,4 +137,30 @@ def describe(depsgraph):
             desc['materials'].setdefault(mname, _material(mat))
             desc['objects'].append({'type': 'instance', 'prototype': name, 'material': mname,
                                     'transform': {'matrix': _matrix_rows(inst.matrix_world)}})
+            for corner in ob.bound_box:
+                p = inst.matrix_world @ mathutils.Vector(corner)
+                for k in range(3):
+                    box_lo[k] = min(box_lo[k], p[k])
+                    box_hi[k] = max(box_hi[k], p[k])
+    box = (box_lo, box_hi) if box_lo[0] <= box_hi[0] else None
+    for ob, matrix in lights:
+        desc['lights'].append(_light(ob, matrix, box))
     return desc
+
+
+def _light(ob, matrix, box):
+    """A Blender light in Whitted's terms: the intensity that gives a Lambertian surface the
+    radiance Cycles/EEVEE give it (mapping.point_intensity, sun_intensity), unless the light's
+    Whitted "Override intensity" gives it directly."""
+    light = ob.data
+    lp = light.whitted
+    if light.type == 'POINT':
+        position = list(matrix.translation)
+        intensity = list(lp.intensity) if lp.use_intensity else \
+            point_intensity(light.energy, light.color, reference_distance(position, box))
+        return {'type': 'point', 'position': position, 'intensity': intensity}
+    if light.type == 'SUN':
+        d = matrix.to_3x3() @ mathutils.Vector((0, 0, -1))
+        intensity = list(lp.intensity) if lp.use_intensity else sun_intensity(light.energy, light.color)
+        return {'type': 'directional', 'direction': list(d), 'intensity': intensity}
+    raise MappingError(f"Whitted: light '{ob.name}' of type {light.type} is not supported")
