@@ -142,24 +142,68 @@ std::string base64(const std::vector<unsigned char>& bytes) {
     return out;
 }
 
-/// The floats exactly as compared, for the page to decode (report_viewer.js, decode_floats):
-/// IEEE binary32, little-endian, the bytes regrouped into four planes (every value's lowest
-/// byte first, then every second byte, ...: neighbouring pixels then share long runs in the
-/// high planes, which deflate roughly halves), deflated in zlib format (what the browser's
-/// DecompressionStream("deflate") reads), base64-encoded.
-std::string encode_floats(const std::vector<float>& values) {
-    const size_t n = values.size();
-    std::vector<unsigned char> planes(4 * n);
-    for (size_t i = 0; i < n; ++i) {
-        const uint32_t bits = std::bit_cast<uint32_t>(values[i]);
-        for (size_t k = 0; k < 4; ++k) planes[k * n + i] = static_cast<unsigned char>(bits >> (8 * k));
-    }
+/// The image's words (the bits of its floats, or its 16-bit codes), channel by channel, each
+/// replaced by its difference from the gradient prediction left + up − upper-left (modulo the
+/// word size; the first row predicts from the left, the first column from above), folded to an
+/// unsigned number (zig-zag: 0, −1, 1, −2, ... → 0, 1, 2, 3, ...), its bytes regrouped into planes
+/// (every word's lowest byte first, then every second byte, ...), deflated in zlib format (what
+/// the browser's DecompressionStream("deflate") reads), base64-encoded. Rendered images are
+/// smooth almost everywhere, so the differences are small numbers whose high bytes are zero:
+/// the planes deflate to a fraction of the raw floats (report_viewer.js, decode_words, undoes it).
+template <typename Word>
+std::string encode_words(const std::vector<Word>& words, int width, int height) {
+    constexpr int channels = 3;
+    constexpr size_t bytes = sizeof(Word);
+    const size_t n = words.size();
+    if (n != size_t(width) * size_t(height) * channels) throw std::logic_error("encode_words: wrong pixel count");
+    std::vector<unsigned char> planes(bytes * n);
+    size_t i = 0;
+    for (int c = 0; c < channels; ++c)
+        for (int y = 0; y < height; ++y)
+            for (int x = 0; x < width; ++x, ++i) {
+                const auto at = [&](int px, int py) {
+                    return words[(size_t(py) * size_t(width) + size_t(px)) * channels + size_t(c)];
+                };
+                const Word predicted = x > 0 && y > 0 ? Word(at(x - 1, y) + at(x, y - 1) - at(x - 1, y - 1))
+                                       : x > 0        ? at(x - 1, y)
+                                       : y > 0        ? at(x, y - 1)
+                                                      : Word(0);
+                const Word r = Word(at(x, y) - predicted);
+                const Word folded = Word(Word(r << 1) ^ Word(0u - (r >> (8 * bytes - 1))));
+                for (size_t k = 0; k < bytes; ++k) planes[k * n + i] = static_cast<unsigned char>(folded >> (8 * k));
+            }
     uLongf size = compressBound(uLong(planes.size()));
     std::vector<unsigned char> deflated(size);
-    if (compress2(deflated.data(), &size, planes.data(), uLong(planes.size()), 6) != Z_OK)
+    if (compress2(deflated.data(), &size, planes.data(), uLong(planes.size()), 9) != Z_OK)
         throw std::runtime_error("cannot compress the report's pixel data");
     deflated.resize(size);
     return base64(deflated);
+}
+
+/// 1/65535 in binary32: OpenImageIO reads a 16-bit code c as float(c) × this.
+constexpr float code_step = 1.0f / 65535.0f;
+
+/// One image of report-data.js: its values exactly, as 16-bit codes when every value is one
+/// (POV-Ray's PNG read as float, unless image.samples averaged it: a quarter of the bytes),
+/// otherwise as the bits of the floats.
+nlohmann::json encoded_image(const std::vector<float>& values, int width, int height) {
+    std::vector<uint16_t> codes(values.size());
+    bool all_codes = true;
+    for (size_t i = 0; i < values.size() && all_codes; ++i) {
+        const float v = values[i];
+        if (!(v >= 0 && v <= 1)) {
+            all_codes = false;
+            break;
+        }
+        codes[i] = static_cast<uint16_t>(std::lround(double(v) * 65535));
+        all_codes = std::bit_cast<uint32_t>(float(codes[i]) * code_step) == std::bit_cast<uint32_t>(v);
+    }
+    if (all_codes)
+        return {
+            {"encoding", "codes16"}, {"code_step", double(code_step)}, {"data", encode_words(codes, width, height)}};
+    std::vector<uint32_t> bits(values.size());
+    for (size_t i = 0; i < values.size(); ++i) bits[i] = std::bit_cast<uint32_t>(values[i]);
+    return {{"encoding", "float32"}, {"data", encode_words(bits, width, height)}};
 }
 
 /// report-data.js: what the page's viewer shows and probes, as one JavaScript assignment. The
@@ -170,7 +214,7 @@ std::string report_data_js(const std::string& scene_path, const Image& ours, con
                            const CheckOptions& options) {
     const ImageComparison& c = r.comparison;
     nlohmann::json j;
-    j["format"] = 1;
+    j["format"] = 2;
     j["scene"] = scene_path;
     j["passed"] = r.passed;
     j["verdict"] = verdict_line(scene_path, r, options);
@@ -179,16 +223,17 @@ std::string report_data_js(const std::string& scene_path, const Image& ours, con
     j["exposure"] = r.exposure;
     j["tolerance_codes"] = options.rule.tolerance * 65535;
     j["encoding"] =
-        "float32 little-endian, byte planes, zlib deflate, base64; values as compared (x 65535 = 16-bit codes)";
-    j["whitted"] = encode_floats(ours.rgb);
-    j["povray"] = encode_floats(theirs.rgb);
+        "per channel, gradient-predicted words (float32 bits or 16-bit codes x code_step), zig-zag, byte planes, "
+        "zlib deflate, base64 (report_viewer.js, decode_image); values as compared (x 65535 = 16-bit codes)";
+    j["whitted"] = encoded_image(ours.rgb, c.width, c.height);
+    j["povray"] = encoded_image(theirs.rgb, c.width, c.height);
     nlohmann::json layers = nlohmann::json::array();
     for (const ImageLayer& layer : ours.layers) {
         if (layer.data || layer.channels.size() != 3) continue;  // normals, depth, ids: not terms of L
         std::vector<float> exposed = layer.values;
         if (r.exposure != 1)
             for (float& v : exposed) v = float(double(v) * r.exposure);  // a power of two: exact
-        layers.push_back({{"name", layer.name}, {"values", encode_floats(exposed)}});
+        layers.push_back({{"name", layer.name}, {"values", encoded_image(exposed, c.width, c.height)}});
     }
     j["layers"] = layers;
     nlohmann::json worst = nlohmann::json::array();
