@@ -303,17 +303,19 @@ std::string code_cells(const float* v) {
 }
 
 /// One image of the side-by-side row, drawn with visible pixels and a box on each of the worst
-/// pixels (the worst one solid, the others dashed).
+/// pixels (the worst one solid, the others dashed). The figure is at most `scale` × the image's
+/// size and shrinks so that the three fit side by side; the boxes are placed in percent of the
+/// image so that they stay on their pixels at any size.
 std::string figure(const std::string& file, const std::string& caption, const ImageComparison& c, int scale) {
     std::string boxes;
     for (size_t i = 0; i < c.worst.size(); ++i)
         boxes += fmt::format(
-            "<div class=\"worst{}\" style=\"left:{}px;top:{}px;width:{s}px;height:{s}px\" title=\"#{} ({}, "
+            "<div class=\"worst{}\" style=\"left:{:.4f}%;top:{:.4f}%;width:{:.4f}%;height:{:.4f}%\" title=\"#{} ({}, "
             "{})\"></div>",
-            i == 0 ? "" : " other", c.worst[i].x * scale - 2, c.worst[i].y * scale - 2, i + 1, c.worst[i].x,
-            c.worst[i].y, fmt::arg("s", scale));
+            i == 0 ? "" : " other", 100.0 * c.worst[i].x / c.width, 100.0 * c.worst[i].y / c.height, 100.0 / c.width,
+            100.0 / c.height, i + 1, c.worst[i].x, c.worst[i].y);
     return fmt::format(
-        "<figure><div class=\"frame\" style=\"width:{w}px;height:{h}px\">"
+        "<figure style=\"max-width:{w}px\"><div class=\"frame\">"
         "<a href=\"{f}\"><img src=\"{f}\" width=\"{w}\" height=\"{h}\" alt=\"{cap}\"></a>{b}"
         "</div><figcaption>{cap}</figcaption></figure>\n",
         fmt::arg("w", c.width * scale), fmt::arg("h", c.height * scale), fmt::arg("f", file), fmt::arg("cap", caption),
@@ -322,7 +324,8 @@ std::string figure(const std::string& file, const std::string& caption, const Im
 
 /// The interactive viewer: one canvas showing two of Whitted / POV-Ray / difference split by a
 /// wipe, zoomed by whole factors; a pixel probe; the difference's threshold. Filled in by
-/// report_viewer.js from report-data.js; without scripts the static images below remain.
+/// report_viewer.js from report-data.js; the verdict, the figures and the images above it are
+/// plain HTML, so the page says what it has to say before any script runs or without scripts.
 std::string explore_section(const ImageComparison& c, double tolerance_codes) {
     const auto source_options = [](const char* selected) {
         std::string o;
@@ -360,8 +363,9 @@ std::string explore_section(const ImageComparison& c, double tolerance_codes) {
          "compared, in 16-bit codes (× 65535), linear, at the compared exposure; the images are shown with the "
          "sRGB curve, as ours.png and povray.png. The difference colours pixels by their largest channel "
          "difference against the threshold as the heat map below does against the tolerance.</p>\n</div>\n";
-    h +=
-        "<p id=\"viewer-missing\">The viewer needs JavaScript and <code>report-data.js</code> next to this page.</p>\n";
+    h += "<p id=\"viewer-missing\">The interactive viewer (wipe, zoom, pixel probe) appears here when JavaScript runs; "
+         "it reads <code>report-data.js</code> next to this page. The verdict, the figures and the images above need "
+         "neither.</p>\n";
     return h;
 }
 
@@ -391,12 +395,12 @@ body { font: 14px/1.45 system-ui, sans-serif; margin: 1.5em; color: #222; max-wi
 h1 { font-size: 1.3em; } h2 { font-size: 1.1em; margin-top: 1.6em; }
 .verdict { display: inline-block; padding: .2em .6em; border-radius: 4px; color: #fff; font-weight: bold; }
 .pass { background: #1a7f37; } .fail { background: #cf222e; }
-.row { display: flex; flex-wrap: wrap; gap: 1.2em; align-items: flex-start; }
-figure { margin: 0; }
+.row { display: flex; gap: 1.2em; align-items: flex-start; }
+figure { margin: 0; } .row figure { flex: 1 1 0; min-width: 0; }
 figcaption { font-size: .9em; color: #444; margin-top: .3em; max-width: 420px; }
 .frame { position: relative; background: #888; }
-.frame img { display: block; image-rendering: pixelated; image-rendering: crisp-edges; }
-.worst { position: absolute; border: 2px solid #ff00ff; box-sizing: content-box; pointer-events: none; }
+.frame img { display: block; width: 100%; height: auto; image-rendering: pixelated; image-rendering: crisp-edges; }
+.worst { position: absolute; border: 2px solid #ff00ff; box-sizing: content-box; margin: -2px; pointer-events: none; }
 .worst.other { border-style: dashed; border-color: #ff00ffa0; }
 table { border-collapse: collapse; margin-top: .4em; }
 td, th { border: 1px solid #ccc; padding: .2em .6em; text-align: right; font-variant-numeric: tabular-nums; }
@@ -419,8 +423,8 @@ kbd { border: 1px solid #bbb; border-radius: 3px; padding: 0 .25em; font-size: .
 <body>
 )";
     h += "<h1>whitted check: " + html_escape(scene_path) + "</h1>\n";
-    h += "<p><span class=\"verdict " + std::string(r.passed ? "pass" : "fail") + "\">" + (r.passed ? "PASS" : "FAIL") +
-         "</span> <code>" + html_escape(verdict) + "</code></p>\n";
+    h += "<p><span id=\"verdict\" class=\"verdict " + std::string(r.passed ? "pass" : "fail") + "\">" +
+         (r.passed ? "PASS" : "FAIL") + "</span> <code>" + html_escape(verdict) + "</code></p>\n";
 
     if (!r.failures.empty()) {
         h += "<p>Rules broken:</p>\n<ul>\n";
@@ -433,7 +437,43 @@ kbd { border: 1px solid #bbb; border-radius: 3px; padding: 0 .25em; font-size: .
              "href=\"povray.exr\">povray.exr</a> hold them as they are.</p>\n</body>\n</html>\n";
         return h;
     }
-    h += explore_section(c, tolerance_codes);
+    h += "<h2>Figures</h2>\n<table>\n";
+    auto row = [&](const std::string& name, const std::string& value) {
+        h += "<tr><th>" + name + "</th><td>" + value + "</td></tr>\n";
+    };
+    // data-metric: the numbers a test reads without scripts and compares with metrics.json.
+    const auto metric = [](const char* key, const std::string& text) {
+        return fmt::format("<span data-metric=\"{}\">{}</span>", key, text);
+    };
+    row(fmt::format("pixels within {:g}/65535", tolerance_codes),
+        fmt::format("{} ({} of {}; {:g}% required)", metric("fraction_within", format_percent(c)),
+                    metric("pixels_within", std::to_string(c.pixels_within)),
+                    metric("pixels", std::to_string(c.pixels)), 100 * options.rule.required_fraction));
+    row("max error", fmt::format("{:.3e} ({} codes; cap {:g})", c.max_error,
+                                 metric("max_error_codes", format_codes(c.max_error)), options.rule.max_error * 65535));
+    if (!c.worst.empty())
+        row("worst pixel", fmt::format("({}, {}): {} codes (the solid box in the images)",
+                                       metric("worst_x", std::to_string(c.worst[0].x)),
+                                       metric("worst_y", std::to_string(c.worst[0].y)),
+                                       metric("worst_error_codes", format_codes(c.worst[0].error))));
+    row("mean error", fmt::format("{:.3e} ({} codes)", c.mean_error,
+                                  metric("mean_error_codes", fmt::format("{:.3f}", c.mean_error * 65535))));
+    row("RMS error", fmt::format("{:.3e} ({:.3f} codes)", c.rms_error, c.rms_error * 65535));
+    row("PSNR (peak 1)", std::isinf(c.psnr) ? std::string("∞ (identical)") : fmt::format("{:.1f} dB", c.psnr));
+    row("NaN/Inf values", fmt::format("{} in Whitted's image, {} in POV-Ray's", c.nonfinite_ours, c.nonfinite_theirs));
+    row("image",
+        fmt::format("{}×{}, image.samples = {}{}", c.width, c.height, r.samples,
+                    r.samples > 1 ? fmt::format(" (POV-Ray rendered {}×{} and each {}×{} block was averaged)",
+                                                c.width * r.samples, c.height * r.samples, r.samples, r.samples)
+                                  : std::string()));
+    row("exposure", exposure_note);
+    row("render time", fmt::format("Whitted {:.3f} s; POV-Ray {:.2f} s ({} run{})", r.whitted_seconds, r.povray_seconds,
+                                   r.povray_runs, r.povray_runs == 1 ? "" : "s"));
+    row("POV-Ray", "<code>" + html_escape(r.povray_program) + "</code>");
+    row("Whitted's intersection",
+        "<code>render.intersection: povray</code> (POV-Ray's decisions at edges, grazes and ties)");
+    h += "</table>\n";
+
     h += "<h2>Images</h2>\n<div class=\"row\">\n";
     h += figure("ours.png", "Whitted (display sRGB of the linear image)", c, scale);
     h += figure("povray.png", "POV-Ray 3.7 (same display transform)", c, scale);
@@ -449,36 +489,12 @@ kbd { border: 1px solid #bbb; border-radius: 3px; padding: 0 .25em; font-size: .
         "<span>≥ {1:g}</span></div>\n"
         "<p>Black to blue: within the tolerance (blue = exactly at it). Yellow to red: outside it (red = twice the "
         "tolerance or more). The solid magenta box marks the worst pixel, dashed boxes the next worst ones "
-        "(listed below). Images shown {2}× enlarged"
+        "(listed below). Images shown {2}× enlarged (smaller when the window is too narrow for the three)"
         "{3}; click one for the file.</p>\n",
         tolerance_codes, 2 * tolerance_codes, scale,
         r.exposure != 1 ? fmt::format(", at exposure {:g}", r.exposure) : std::string());
 
-    h += "<h2>Figures</h2>\n<table>\n";
-    auto row = [&](const std::string& name, const std::string& value) {
-        h += "<tr><th>" + name + "</th><td>" + value + "</td></tr>\n";
-    };
-    row("max error", fmt::format("{:.3e} ({} codes; cap {:g})", c.max_error, format_codes(c.max_error),
-                                 options.rule.max_error * 65535));
-    row("mean error", fmt::format("{:.3e} ({:.3f} codes)", c.mean_error, c.mean_error * 65535));
-    row("RMS error", fmt::format("{:.3e} ({:.3f} codes)", c.rms_error, c.rms_error * 65535));
-    row("PSNR (peak 1)", std::isinf(c.psnr) ? std::string("∞ (identical)") : fmt::format("{:.1f} dB", c.psnr));
-    row(fmt::format("pixels within {:g}/65535", tolerance_codes),
-        fmt::format("{} ({} of {}; {:g}% required)", format_percent(c), c.pixels_within, c.pixels,
-                    100 * options.rule.required_fraction));
-    row("NaN/Inf values", fmt::format("{} in Whitted's image, {} in POV-Ray's", c.nonfinite_ours, c.nonfinite_theirs));
-    row("image",
-        fmt::format("{}×{}, image.samples = {}{}", c.width, c.height, r.samples,
-                    r.samples > 1 ? fmt::format(" (POV-Ray rendered {}×{} and each {}×{} block was averaged)",
-                                                c.width * r.samples, c.height * r.samples, r.samples, r.samples)
-                                  : std::string()));
-    row("exposure", exposure_note);
-    row("render time", fmt::format("Whitted {:.3f} s; POV-Ray {:.2f} s ({} run{})", r.whitted_seconds, r.povray_seconds,
-                                   r.povray_runs, r.povray_runs == 1 ? "" : "s"));
-    row("POV-Ray", "<code>" + html_escape(r.povray_program) + "</code>");
-    row("Whitted's intersection",
-        "<code>render.intersection: povray</code> (POV-Ray's decisions at edges, grazes and ties)");
-    h += "</table>\n";
+    h += explore_section(c, tolerance_codes);
 
     h += fmt::format("<h2>The {} worst pixels</h2>\n", c.worst.size());
     h += "<p>Column from the left, row from the top; values are linear, at the compared exposure, in 16-bit codes "
