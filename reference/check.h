@@ -75,10 +75,10 @@ std::vector<TermScene> term_scenes(const SceneDescription& description);
 /// then one line naming the terms that failed. True when all pass.
 bool run_check_terms(const std::string& scene_path, const CheckOptions& options);
 
-/// Writes ours.png, povray.png, diff.png (scaled heat map), ours.exr, povray.exr, diff.exr,
-/// metrics.json and report.html into `dir`. `ours` and `theirs` are the images as compared,
-/// i.e. already multiplied by result.exposure; the EXRs are written at the scene's own scale
-/// (ours.exr is what `whitted render` writes), the PNGs and the heat map at the compared scale.
+/// Writes ours.png, povray.png, diff.png (scaled heat map), ours.exr, povray.exr (both losslessly
+/// compressed), report-data.js, metrics.json and report.html into `dir`. `ours` and `theirs` are the images as
+/// compared, i.e. already multiplied by result.exposure; the EXRs are written at the scene's own scale (ours.exr is
+/// what `whitted render` writes), the PNGs and the heat map at the compared scale.
 void write_report(const std::string& dir, const std::string& scene_path, const Image& ours, const Image& theirs,
                   const CheckResult& result, const CheckOptions& options);
 

@@ -7,26 +7,45 @@
 "use strict";
 (function () {
     const data = window.WHITTED_REPORT;
-    if (!data || data.format !== 1) return;  // the page still shows its static images
+    if (!data || data.format !== 2) return;  // the page still shows its static images
     const width = data.width, height = data.height, count = width * height;
     const $ = (id) => document.getElementById(id);
     const view = $("view"), ctx = view.getContext("2d");
 
-    // report-data.js's encoding (reference/report.cpp, encode_floats): base64 of zlib-deflated
-    // byte planes of little-endian binary32 values.
-    async function decode_floats(text, n) {
-        const binary = atob(text);
+    // report-data.js's encoding (reference/report.cpp, encode_words): base64 of zlib-deflated
+    // byte planes of zig-zag folded differences from the gradient prediction left + up -
+    // upper-left, channel by channel; the words are the bits of binary32 values ("float32") or
+    // 16-bit codes, each value float(code) x code_step ("codes16").
+    async function decode_image(image, n) {
+        const binary = atob(image.data);
         const bytes = new Uint8Array(binary.length);
         for (let i = 0; i < binary.length; ++i) bytes[i] = binary.charCodeAt(i);
         const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("deflate"));
         const planes = new Uint8Array(await new Response(stream).arrayBuffer());
-        if (planes.length !== 4 * n) throw new Error("report-data.js: " + planes.length + " bytes, expected " + 4 * n);
-        const out = new Uint8Array(4 * n);
-        for (let k = 0; k < 4; ++k) {
-            const plane = planes.subarray(k * n, (k + 1) * n);
-            for (let i = 0; i < n; ++i) out[4 * i + k] = plane[i];
-        }
-        return new Float32Array(out.buffer);
+        if (n !== 3 * width * height) throw new Error("report-data.js: not an RGB image of " + width + "x" + height);
+        const size = image.encoding === "float32" ? 4 : image.encoding === "codes16" ? 2 : 0;
+        if (!size) throw new Error("report-data.js: unknown encoding " + image.encoding);
+        if (planes.length !== size * n) throw new Error("report-data.js: " + planes.length + " bytes, expected " + size * n);
+        const words = size === 4 ? new Uint32Array(n) : new Uint16Array(n);
+        const mask = size === 4 ? 0xffffffff : 0xffff;
+        for (let c = 0, i = 0; c < 3; ++c)
+            for (let y = 0; y < height; ++y)
+                for (let x = 0; x < width; ++x, ++i) {
+                    let folded = 0;
+                    for (let k = size - 1; k >= 0; --k) folded = folded * 256 + planes[k * n + i];
+                    // Unfolded by arithmetic on whole numbers (exact below 2^53), then reduced modulo 2^32
+                    // or 2^16 as encode_words computed it.
+                    const r = folded % 2 ? -(folded + 1) / 2 : folded / 2;
+                    const at = (px, py) => words[(py * width + px) * 3 + c];
+                    const predicted = x > 0 && y > 0 ? at(x - 1, y) + at(x, y - 1) - at(x - 1, y - 1)
+                                    : x > 0 ? at(x - 1, y) : y > 0 ? at(x, y - 1) : 0;
+                    const w = predicted + r;
+                    words[(y * width + x) * 3 + c] = size === 4 ? w >>> 0 : w & mask;
+                }
+        if (size === 4) return new Float32Array(words.buffer);
+        const out = new Float32Array(n);
+        for (let i = 0; i < n; ++i) out[i] = Math.fround(words[i] * image.code_step);
+        return out;
     }
 
     // A value in codes with one decimal, as `whitted check` prints it (fmt's "{:.1f}" of v x 65535).
@@ -331,9 +350,9 @@
     }
 
     async function start() {
-        whitted = await decode_floats(data.whitted, 3 * count);
-        povray = await decode_floats(data.povray, 3 * count);
-        for (const layer of data.layers) layers.push({name: layer.name, values: await decode_floats(layer.values, 3 * count)});
+        whitted = await decode_image(data.whitted, 3 * count);
+        povray = await decode_image(data.povray, 3 * count);
+        for (const layer of data.layers) layers.push({name: layer.name, values: await decode_image(layer.values, 3 * count)});
         difference = new Float64Array(count);
         for (let i = 0; i < count; ++i) difference[i] = pixel_difference(i);
         state.sources.whitted = image_canvas(whitted);

@@ -12,9 +12,11 @@ the wipe, zooms, probes pixels and compares what the page shows with those numbe
 usage: report_browser.py WHITTED SOURCE_DIR WORK_DIR TOOLS_DIR CASE
   CASE: layers  (check --layers all: the probe's per-term breakdown)
         plain   (no layers: no breakdown)
+        static  (no layers, JavaScript off: the verdict, the figures and the three images as plain HTML)
         index   (scripts/validate on one scene: the index page's thumbnails; needs POV-Ray)
 """
 import json
+import math
 import os
 import re
 import shutil
@@ -162,6 +164,29 @@ def expectations_for_report(report, layers_wanted):
             "worst_count": len(worst)}
 
 
+def static_expectations(report):
+    """What the page shows before any script runs: metrics.json's verdict and numbers, formatted
+    as `whitted check` prints them, and the three images at the image's size."""
+    with open(os.path.join(report, "metrics.json")) as f:
+        m = json.load(f)
+    if not m["worst_pixels"]:
+        fail("metrics.json lists no worst pixels")
+    worst = m["worst_pixels"][0]
+    within = "100.000%" if m["pixels_within"] == m["pixels"] else \
+        f"{math.floor(m['fraction_within'] * 100000.0) / 1000.0:.3f}%"
+    metrics = {"fraction_within": within, "pixels_within": str(m["pixels_within"]), "pixels": str(m["pixels"]),
+               "max_error_codes": f"{m['max_error_codes']:.1f}", "worst_x": str(worst["x"]),
+               "worst_y": str(worst["y"]), "worst_error_codes": f"{worst['error_codes']:.1f}",
+               "mean_error_codes": f"{m['mean_error'] * 65535:.3f}"}
+    images = {}
+    for name in ("whitted_png", "povray_png", "heat_map_png"):
+        png, _ = read(os.path.join(report, m["files"][name]))
+        if png.shape[:2] != (m["height"], m["width"]):
+            fail(f"{m['files'][name]} is {png.shape[1]}x{png.shape[0]}, metrics.json says {m['width']}x{m['height']}")
+        images[m["files"][name]] = [m["width"], m["height"]]
+    return {"verdict": "PASS" if m["passed"] else "FAIL", "metrics": metrics, "images": images}
+
+
 def main():
     if len(sys.argv) != 6:
         print(__doc__)
@@ -175,7 +200,7 @@ def main():
     shots = os.path.join(work, "screenshots")
     os.makedirs(shots)
 
-    if case in ("layers", "plain"):
+    if case in ("layers", "plain", "static"):
         report = os.path.join(work, "report")
         command = [whitted, "check", os.path.join(source, SCENE), "--povray-image", os.path.join(source, REFERENCE),
                    "--exposure", "1", "--report", report]
@@ -185,7 +210,7 @@ def main():
         print(run.stdout, end="")
         if run.returncode != 0:
             fail(f"whitted check exited {run.returncode}: {run.stderr}")
-        expect = expectations_for_report(report, case == "layers")
+        expect = static_expectations(report) if case == "static" else expectations_for_report(report, case == "layers")
         page = os.path.join(report, "report.html")
         print(f"report-data.js: {os.path.getsize(os.path.join(report, 'report-data.js'))} bytes, "
               f"report.html: {os.path.getsize(page)} bytes")

@@ -23,8 +23,9 @@ function same(actual, expected, what) {
 
 async function probeByClick(page, x, y) {
     // A real click at the centre of image pixel (x, y) on the canvas, at the viewer's zoom and pan
-    // (scrolled to the top first: an element screenshot may have scrolled the canvas out of view).
-    await page.evaluate(() => window.scrollTo(0, 0));
+    // (the canvas scrolled to the top of the window first: the static view is above it, and an
+    // element screenshot may have scrolled it out of view).
+    await page.evaluate(() => document.getElementById("view").scrollIntoView({block: "start"}));
     const v = await page.evaluate(() => ({zoom: whittedViewer.zoom, panX: whittedViewer.panX, panY: whittedViewer.panY}));
     const box = await page.locator("#view").boundingBox();
     const sx = x * v.zoom - v.panX + v.zoom / 2, sy = y * v.zoom - v.panY + v.zoom / 2;
@@ -147,6 +148,29 @@ async function reportCase(page) {
     check(shown.where.startsWith(`pixel (${first.x}, ${first.y})`), `worst row click probes it: "${shown.where}"`);
 }
 
+// JavaScript off: what a screenshot tool or a reader without scripts sees.
+async function staticCase(page, viewport) {
+    const ran = await page.evaluate(() => document.body.dataset.viewer || null);
+    same(ran, null, "no script ran (body data-viewer)");
+    check(await page.locator("#viewer").isHidden(), "the interactive viewer stays hidden");
+    same(await page.locator("#verdict").textContent(), expect.verdict, "verdict");
+    for (const [key, value] of Object.entries(expect.metrics))
+        same(await page.locator(`[data-metric=${key}]`).textContent(), value, `${key} (metrics.json)`);
+    const inView = async (locator, what) => {
+        const box = await locator.boundingBox();
+        check(box && box.y >= 0 && box.y + box.height <= viewport.height && box.x + box.width <= viewport.width,
+              `${what} within the first ${viewport.width}x${viewport.height} view: ${JSON.stringify(box)}`);
+    };
+    await inView(page.locator("#verdict"), "verdict");
+    await inView(page.locator("[data-metric=worst_error_codes]").locator("xpath=ancestor::table"), "figures table");
+    for (const [src, size] of Object.entries(expect.images)) {
+        const img = page.locator(`.row img[src="${src}"]`);
+        same(await img.evaluate((i) => [i.complete, i.naturalWidth, i.naturalHeight]), [true, ...size], `${src} loaded`);
+        await inView(img, src);
+    }
+    await page.screenshot({path: path.join(shots, "static.png")});
+}
+
 async function indexCase(page) {
     const thumbs = await page.evaluate(() => Array.from(document.querySelectorAll("img.thumb")).map((i) => ({
         src: i.getAttribute("src"), w: i.naturalWidth, h: i.naturalHeight, link: i.closest("a").getAttribute("href")})));
@@ -169,7 +193,8 @@ async function indexCase(page) {
         // As root (CI's chroot) Chromium refuses its sandbox; /dev/shm is small in a chroot.
         args: [...(root ? ["--no-sandbox"] : []), "--disable-dev-shm-usage", "--disable-gpu"],
     });
-    const context = await browser.newContext({viewport: {width: 1400, height: 1000}});
+    const viewport = {width: 1400, height: 1000};
+    const context = await browser.newContext({viewport, javaScriptEnabled: caseName !== "static"});
     const blocked = [];
     let decoy = 0;
     // No network: every request that is not a file:// URL is aborted and fails the test, except
@@ -187,7 +212,9 @@ async function indexCase(page) {
     page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
     const started = Date.now();
     await page.goto(url.pathToFileURL(pagePath).href);
-    if (caseName !== "index") {
+    if (caseName === "static") {
+        await staticCase(page, viewport);
+    } else if (caseName !== "index") {
         await page.waitForSelector("body[data-viewer]", {timeout: 20000});
         const state = await page.evaluate(() => document.body.dataset.viewer);
         check(state === "ready", `viewer ${state} (${Date.now() - started} ms after opening)`);

@@ -23,8 +23,8 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import fake_povray  # noqa: E402
-REPORT_FILES = ["povray.log", "povray-16bit.png", "scene.pov", "scene.ini", "ours.exr", "povray.exr", "diff.exr",
-                "ours.png", "povray.png", "diff.png", "metrics.json", "report-data.js", "report.html"]
+REPORT_FILES = ["povray.log", "povray-16bit.png", "scene.pov", "scene.ini", "ours.exr", "povray.exr", "ours.png",
+                "povray.png", "diff.png", "metrics.json", "report-data.js", "report.html"]
 SCENE = ("version: 1\ncamera: { eye: [0, 0, 5], look_at: [0, 0, 0] }\n"
          "image: { width: 96, height: 72, background: [0.5, 0.25, 0.125] }\n"
          "lights: []\nmaterials: {}\nobjects: []\n")

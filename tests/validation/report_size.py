@@ -1,0 +1,49 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: MIT
+"""The size of a `whitted check --report` folder for a 640x480 image (docs/validation.md, "Reading
+a report"): tests/pov/three_coloured_lights.yaml at 640x480, checked against the real POV-Ray;
+every file's size is printed and the total must stay under BOUND bytes.
+
+usage: report_size.py WHITTED SOURCE_DIR"""
+import os
+import subprocess
+import sys
+import tempfile
+
+BOUND = 6_500_000  # measured 5.9 MB; the uncompressed EXRs or the raw floats in report-data.js break it
+
+
+def main():
+    if len(sys.argv) != 3:
+        print(__doc__)
+        sys.exit(2)
+    whitted, source = sys.argv[1:]
+    with open(os.path.join(source, "tests", "pov", "three_coloured_lights.yaml")) as f:
+        scene = f.read()
+    if "image: { width: 96, height: 72 }" not in scene:
+        print("FAIL: three_coloured_lights.yaml no longer has the image line this test resizes")
+        sys.exit(1)
+    with tempfile.TemporaryDirectory(prefix="whitted-report-size-") as d:
+        path = os.path.join(d, "scene.yaml")
+        with open(path, "w") as f:
+            f.write(scene.replace("image: { width: 96, height: 72 }", "image: { width: 640, height: 480 }"))
+        report = os.path.join(d, "report")
+        run = subprocess.run([whitted, "check", path, "-q", "--report", report], capture_output=True, text=True,
+                             timeout=300, env=dict(os.environ, HOME=d))
+        print(run.stdout, end="")
+        if run.returncode != 0:
+            print(f"FAIL: whitted check exited {run.returncode}: {run.stderr}")
+            sys.exit(1)
+        total = 0
+        for name in sorted(os.listdir(report)):
+            size = os.path.getsize(os.path.join(report, name))
+            total += size
+            print(f"{size:>10}  {name}")
+        print(f"{total:>10}  total (bound {BOUND})")
+        if total > BOUND:
+            print(f"FAIL: the 640x480 report is {total} bytes, more than {BOUND}")
+            sys.exit(1)
+
+
+if __name__ == "__main__":
+    main()
