@@ -152,9 +152,9 @@ void check_report_dir(const CheckOptions& options) {
 }
 
 /// Every file `check --report` may write in the report directory.
-constexpr const char* report_files[] = {pov_name,       ini_name,         povray_image_name, "povray.log", "ours.exr",
-                                        "povray.exr",   "diff.exr",       "ours.png",        "povray.png", "diff.png",
-                                        "metrics.json", "report-data.js", "report.html"};
+constexpr const char* report_files[] = {pov_name,   ini_name,       povray_image_name, "povray.log",
+                                        "ours.exr", "povray.exr",   "ours.png",        "povray.png",
+                                        "diff.png", "metrics.json", "report-data.js",  "report.html"};
 
 /// A report file that is one of the check's inputs (the scene, a mesh or MTL file, by any name:
 /// a scene copied to `r/metrics.json`) is a usage error before the render: the report would
