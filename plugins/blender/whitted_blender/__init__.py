@@ -200,12 +200,17 @@ def _redraw_when_ready(session):
     freed while a render runs, and the worker must not hold it (its __del__ stops the worker)."""
     if session._stopped:
         return None
+    rendered = [area for window in bpy.context.window_manager.windows for area in window.screen.areas
+                if area.type == 'VIEW_3D' and area.spaces.active.shading.type == 'RENDERED']
+    if not rendered:
+        # No view in Rendered shading: stop now. Blender frees the engine (whose __del__ stops the
+        # session too) only when Python collects it, measured up to 11 s later.
+        session.stop(wait=False)
+        return None
     if session.dirty:
         session.dirty = False
-        for window in bpy.context.window_manager.windows:
-            for area in window.screen.areas:
-                if area.type == 'VIEW_3D' and area.spaces.active.shading.type == 'RENDERED':
-                    area.tag_redraw()
+        for area in rendered:
+            area.tag_redraw()
     return 0.01
 
 

@@ -215,11 +215,12 @@ class ViewportSession:
             time.sleep(0.005)
         return False
 
-    def stop(self):
-        """Cancel the running render (within a progress call, 50 ms) and end the thread."""
+    def stop(self, wait=True):
+        """Cancel the running render (at its next progress call) and end the thread; with
+        wait=False, do not wait for the thread (the UI's timer must not block)."""
         with self._cv:
             self._stopped = True
             self._generation += 1
             self._cv.notify()
-        if self._thread is not threading.current_thread():
+        if wait and self._thread is not threading.current_thread():
             self._thread.join()
