@@ -13,11 +13,18 @@ import os
 import sys
 import tempfile
 
+import weakref
+
 import bpy
 import numpy as np
 
 from .locate import ModuleNotFound, import_whitted
 from .mapping import MappingError, dumps
+from .viewport import ViewportSession, display_rgba, region_camera
+
+# Every viewport session the engine started (weak: a freed engine's stopped session goes away);
+# for tests and scripts that measure or wait on the viewport.
+viewport_sessions = weakref.WeakSet()
 
 
 def _whitted():
@@ -66,6 +73,11 @@ class WhittedRenderEngine(bpy.types.RenderEngine):
     last_scene_text = None
     last_error = None
     last_cancelled = False
+
+    def __init__(self):
+        super().__init__()
+        self._whitted_session = None   # the viewport's ViewportSession (Rendered shading only)
+        self._whitted_texture = None   # ((generation, full), GPUTexture) last uploaded
 
     def should_break(self):
         """Blender's Esc/cancel; a plain Python method so a test can replace it (RNA methods
@@ -118,6 +130,88 @@ class WhittedRenderEngine(bpy.types.RenderEngine):
         rgba[:, :, :3] = img[::-1]  # Blender's rows start at the bottom
         result.layers[0].passes["Combined"].rect = rgba.reshape(-1, 4)
         self.end_result(result)
+
+    # -- Rendered shading in the 3D viewport (viewport.py) --------------------------------------
+    def _viewport(self, depsgraph):
+        s = self._whitted_session
+        if s is None:
+            s = ViewportSession(_whitted(), threads=depsgraph.scene.whitted.threads)
+            s.dirty = False
+
+            def on_image():  # worker thread: only flag; the main thread's timer redraws
+                s.dirty = True
+            s.on_image = on_image
+            bpy.app.timers.register(lambda: _redraw_when_ready(s), first_interval=0.01)
+            self._whitted_session = s
+            viewport_sessions.add(s)
+        return s
+
+    def view_update(self, context, depsgraph):
+        try:
+            s = self._viewport(depsgraph)
+        except ModuleNotFound as e:
+            self.update_stats("", str(e).split("\n")[0])
+            return
+        s.update_scene(depsgraph)
+
+    def view_draw(self, context, depsgraph):
+        s = self._whitted_session
+        if s is None:
+            return
+        region = context.region
+        try:
+            s.update_view(region_camera(context.region_data), region.width, region.height)
+        except MappingError as e:
+            s._fail(str(e))
+        if s.error is not None:
+            self.update_stats("", s.error)
+            return
+        image, generation, full = s.image, s.image_generation, s.image_full
+        if image is None:
+            return
+        self.update_stats("", "Whitted: " + ("done" if full and generation == s._generation else "rendering"))
+        import gpu
+        from gpu_extras.presets import draw_texture_2d
+        key = (generation, full)
+        if self._whitted_texture is None or self._whitted_texture[0] != key:
+            h, w = image.shape[:2]
+            buf = gpu.types.Buffer('FLOAT', w * h * 4, display_rgba(image).ravel())
+            self._whitted_texture = (key, gpu.types.GPUTexture((w, h), format='RGBA32F', data=buf))
+        gpu.state.blend_set('ALPHA_PREMULT')
+        # Blender's view transform, look, exposure and display device apply to the linear pixels.
+        self.bind_display_space_shader(depsgraph.scene)
+        draw_texture_2d(self._whitted_texture[1], (0, 0), region.width, region.height)
+        self.unbind_display_space_shader()
+        gpu.state.blend_set('NONE')
+
+    def __del__(self):
+        # The viewport left Rendered mode (or the engine is freed): cancel and end the worker.
+        try:
+            s = self._whitted_session
+        except Exception:  # the RNA side is gone already
+            return
+        if s is not None:
+            s.stop()
+
+
+def _redraw_when_ready(session):
+    """A main-thread timer per viewport session: redraw the 3D views in Rendered shading when the
+    worker has a better image. Why not engine.tag_redraw() from the worker: the engine may be
+    freed while a render runs, and the worker must not hold it (its __del__ stops the worker)."""
+    if session._stopped:
+        return None
+    rendered = [area for window in bpy.context.window_manager.windows for area in window.screen.areas
+                if area.type == 'VIEW_3D' and area.spaces.active.shading.type == 'RENDERED']
+    if not rendered:
+        # No view in Rendered shading: stop now. Blender frees the engine (whose __del__ stops the
+        # session too) only when Python collects it, measured up to 11 s later.
+        session.stop(wait=False)
+        return None
+    if session.dirty:
+        session.dirty = False
+        for area in rendered:
+            area.tag_redraw()
+    return 0.01
 
 
 def export_render_depsgraph(scene, filepath):

@@ -71,11 +71,8 @@ def _mesh(obj_eval):
         obj_eval.to_mesh_clear()
 
 
-def describe(depsgraph):
-    scene = depsgraph.scene
-    r = scene.render
-    width = int(r.resolution_x * r.resolution_percentage / 100)
-    height = int(r.resolution_y * r.resolution_percentage / 100)
+def scene_camera(scene, width, height):
+    """The scene's active camera in Whitted's terms (what F12 renders through)."""
     cam_obj = scene.camera
     if cam_obj is None:
         raise MappingError("Whitted: the scene has no active camera")
@@ -95,6 +92,21 @@ def describe(depsgraph):
                                        cam.sensor_fit, width, height)
     else:
         raise MappingError("Whitted: panoramic cameras are not supported")
+    return camera
+
+
+def describe(depsgraph, camera=None, size=None):
+    """The scene description of `depsgraph`. By default through the scene's camera at the render
+    resolution (F12); the viewport passes its own camera dict and (width, height) instead."""
+    scene = depsgraph.scene
+    r = scene.render
+    if size is None:
+        width = int(r.resolution_x * r.resolution_percentage / 100)
+        height = int(r.resolution_y * r.resolution_percentage / 100)
+    else:
+        width, height = size
+    if camera is None:
+        camera = scene_camera(scene, width, height)
     props = scene.whitted
     world = scene.world
     bg = [0.0, 0.0, 0.0]

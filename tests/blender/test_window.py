@@ -1,0 +1,70 @@
+#!/usr/bin/python3
+"""ctest blender.window: a real Blender window under Xvfb (Mesa's software OpenGL): the factory scene's 3D
+view in Rendered shading with Whitted; its pixels on screen equal `whitted render` of the scene text the
+viewport rendered, through the Standard view transform (sRGB), within 8-bit display quantisation; leaving
+Rendered shading ends the render thread. Fails (does not skip) without Xvfb or a GL context.
+Usage: test_window.py [SCREENSHOT_COPY]"""
+import json, os, shutil, subprocess, sys, tempfile
+import numpy as np
+if shutil.which("blender") is None:
+    print("SKIPPED: blender is not installed (apt-get install blender)"); sys.exit(77)
+if os.environ.get("WHITTED_TEST_SANITIZED"):
+    print("SKIPPED: sanitizer build: Blender cannot load the ASan-built whitted module; "
+          "run in the plain build (scripts/test)"); sys.exit(77)
+if shutil.which("xvfb-run") is None or shutil.which("Xvfb") is None:
+    sys.exit("FAIL: xvfb-run/Xvfb not installed (apt-get install xvfb xauth): the window test cannot run")
+import OpenImageIO as oiio
+here = os.path.dirname(os.path.abspath(__file__))
+out = tempfile.mkdtemp(prefix="whitted-blender-window-")
+start = os.path.join(out, "start.blend")  # opening a file: no splash screen over the view
+subprocess.run(["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr",
+                f"import bpy; bpy.ops.wm.save_as_mainfile(filepath={start!r})"], check=True, capture_output=True)
+r = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x800x24", "blender", "--factory-startup", start,
+                    "--python-exit-code", "1", "--python", os.path.join(here, "window_checks.py"), "--", out],
+                   capture_output=True, text=True, timeout=240)
+result = os.path.join(out, "result.json")
+if r.returncode != 0 or not os.path.exists(result):
+    print(r.stdout[-3000:], r.stderr[-3000:])
+    sys.exit(f"FAIL: windowed Blender exited {r.returncode} without a result (no X display or GL context?)")
+res = json.load(open(result))
+assert "error" not in res, res["error"]
+assert res["gl_renderer"], res
+subprocess.run([os.environ["WHITTED"], "render", os.path.join(out, "view.json"), "-o", os.path.join(out, "cli.exr")],
+               check=True, capture_output=True)
+screen = oiio.ImageBuf(os.path.join(out, "screen.png")).get_pixels(oiio.UINT8)[:, :, :3].astype(int)
+rg = res["region"]
+assert screen.shape[:2] == (res["window"]["height"], res["window"]["width"]), (screen.shape, res["window"])
+H = screen.shape[0]
+top = H - (rg["y"] + rg["height"])  # window coordinates count from the bottom; image rows from the top
+view = screen[top:top + rg["height"], rg["x"]:rg["x"] + rg["width"]]
+linear = oiio.ImageBuf(os.path.join(out, "cli.exr")).get_pixels(oiio.FLOAT)[:, :, :3]
+assert linear.shape == view.shape, (linear.shape, view.shape)
+assert linear.max() > linear.min(), "flat image"
+c = np.clip(linear, 0.0, 1.0)  # Standard: the sRGB curve, clipped
+expect = np.rint(255 * np.where(c <= 0.0031308, 12.92 * c, 1.055 * c ** (1 / 2.4) - 0.055)).astype(int)
+mask = np.ones(view.shape[:2], bool)
+mask[[0, -1], :] = False  # the area's 1-pixel border is drawn over the region's edge
+# ... and at the left and right edges the arrows that reopen the hidden toolbar and sidebar
+mask[:, :16] = mask[:, -16:] = False
+for o in res["others"]:  # headers drawn over the view (region overlap)
+    y0, y1 = max(o["y"], rg["y"]), min(o["y"] + o["height"], rg["y"] + rg["height"])
+    x0, x1 = max(o["x"], rg["x"]), min(o["x"] + o["width"], rg["x"] + rg["width"])
+    if y0 < y1 and x0 < x1:
+        mask[rg["y"] + rg["height"] - y1:rg["y"] + rg["height"] - y0, x0 - rg["x"]:x1 - rg["x"]] = False
+d = np.abs(view - expect).max(axis=2)[mask]
+within = (d <= 2).mean()
+no_cm = np.abs(view - np.rint(255 * c).astype(int)).max(axis=2)[mask]
+if not (within >= 0.999 and d.max() <= 4):
+    bad = np.argwhere((np.abs(view - expect).max(axis=2) > 4) & mask)
+    sys.exit(f"FAIL: {100 * within:.3f}% within 2 codes, max {d.max()}; {len(bad)} pixels > 4, first (row, col) "
+             f"{bad[:5].tolist()} of the view")
+assert (no_cm > 8).mean() > 0.5, "the drawn pixels look linear: the display transform was not applied"
+assert res["alive_before"] and not res["alive_after_solid"], res
+if len(sys.argv) > 1:
+    shutil.copyfile(os.path.join(out, "screen.png"), sys.argv[1])
+coarse = next(e for e in res["log"] if e[0] == "coarse")
+full = next(e for e in res["log"] if e[0] == "full")
+print(f"blender.window: {res['gl_renderer']}; view {rg['width']}x{rg['height']}: {100 * within:.3f}% of "
+      f"{d.size} pixels within 2 codes of whitted render + sRGB, max {d.max()}; coarse {coarse[1]}x{coarse[2]} "
+      f"after {coarse[3]:.3f} s, full after {full[3]:.3f} s; thread ended {res['stopped_after_seconds']:.2f} s "
+      f"after leaving Rendered")
