@@ -21,6 +21,9 @@ find_package(ZLIB REQUIRED)
 # The Cornell CS4620 course's XML scenes (renderer/whitted/scene/course_xml.cpp): expat reports
 # the line and column of every element, which the error messages need.
 find_package(EXPAT REQUIRED)
+# cpp-httplib (libcpp-httplib-dev): the local web server of `whitted live` (docs/live.md). Debian
+# builds it as a library with TLS, zlib and brotli on; pkg-config gives the matching definitions.
+pkg_check_modules(CPPHTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)
 
 # Quirk A: Debian built OpenImageIO with OpenCV, and its exported target names
 # /usr/include/opencv4, which does not exist unless libopencv-dev (+417 MB) is installed.

@@ -7,6 +7,7 @@
 #include "converters/pov_writer.h"
 #include "converters/yaml_writer.h"
 #include "explain_command.h"
+#include "live_command.h"
 #include "reference/check.h"
 #include "whitted/core/plugin.h"
 #include "whitted/output/atomic_files.h"
@@ -782,6 +783,19 @@ int main(int argc, char** argv) {
     explain_cmd->add_option("-t,--threads", explain_threads, "Threads for building the BVH (default: all cores)")
         ->check(CLI::Range(0, 4096));
 
+    LiveArguments live_args;
+    bool live_no_open = false;
+    CLI::App* live_cmd = app.add_subcommand(
+        "live",
+        "Serve a page on 127.0.0.1 with the scene rendered and sliders for its materials and lights, "
+        "re-rendered as they move and when the file changes (docs/live.md)");
+    live_cmd->add_option("scene", live_args.scene, "Scene file")->required()->check(CLI::ExistingFile);
+    live_cmd->add_option("--port", live_args.port, "Port on 127.0.0.1 (default: a free one, printed)")
+        ->check(CLI::Range(1, 65535));
+    live_cmd->add_flag("--no-open", live_no_open, "Print the address only; do not open it in a browser");
+    live_cmd->add_option("-t,--threads", live_args.threads, "Worker threads (default: all cores)")
+        ->check(CLI::Range(0, 4096));
+
     std::string convert_scene, convert_output;
     CLI::App* convert_cmd = app.add_subcommand("convert", "Convert a scene to another renderer's format");
     convert_cmd->add_option("scene", convert_scene, "Scene file")->required()->check(CLI::ExistingFile);
@@ -896,7 +910,11 @@ int main(int argc, char** argv) {
         return code == 0 ? 0 : exit_bad_input;
     }
 
-    if ((*render_cmd || *check_cmd || *explain_cmd) && !embree_isa_usable()) return exit_bad_input;
+    if ((*render_cmd || *check_cmd || *explain_cmd || *live_cmd) && !embree_isa_usable()) return exit_bad_input;
+    if (*live_cmd) {
+        live_args.open_browser = !live_no_open;
+        return run_live(live_args);
+    }
     if (*explain_cmd)
         return run_explain(explain_scene, explain_pixel_text, explain_json, explain_summary, explain_threads);
     if (*render_cmd) {

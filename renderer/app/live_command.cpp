@@ -1,0 +1,467 @@
+// SPDX-License-Identifier: MIT
+// `whitted live`: the lecture's LightMaterial demo, ray traced. A small HTTP server on 127.0.0.1
+// serves one page (live_page.html, embedded) and renders the scene file with the page's slider
+// values written over the file's: each render parses the file's text again, replaces the values
+// in the description and validates it, exactly as `whitted render` reads a file that says them,
+// so the image equals that render bit for bit (docs/live.md).
+
+#include "live_command.h"
+
+#include "api/api_internal.h"
+#include "live_page_html.h"
+#include "whitted/scene/description.h"
+#include "whitted/scene/scene.h"
+#include "whitted/whitted.h"
+
+#include <httplib.h>
+#include <nlohmann/json.hpp>
+
+#include <fcntl.h>
+#include <pthread.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+extern char** environ;
+
+namespace whitted {
+namespace {
+
+using json = nlohmann::json;
+
+constexpr int exit_failure = 1, exit_bad_input = 2;
+
+/// A mistake in what the page sent (HTTP 400), as opposed to one in the scene file (422).
+struct BadRequest : std::invalid_argument {
+    using std::invalid_argument::invalid_argument;
+};
+
+/// What tells an editor's save apart from no change: the file's modification time and size.
+struct FileStamp {
+    int64_t mtime_ns = -1, size = -1;
+    bool operator==(const FileStamp&) const = default;
+};
+
+FileStamp stamp_of(const std::string& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) return {};
+    return {int64_t(st.st_mtim.tv_sec) * 1'000'000'000 + st.st_mtim.tv_nsec, int64_t(st.st_size)};
+}
+
+std::string read_scene_text(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error(path + ": cannot be read");
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (int64_t(text.str().size()) > limits::max_scene_file_bytes)
+        throw std::runtime_error(path + ": more than " + std::to_string(limits::max_scene_file_bytes) +
+                                 " bytes, the scene file limit");
+    return text.str();
+}
+
+json to_json(const Vec3& v) {
+    return json::array({v.x, v.y, v.z});
+}
+
+double finite_number(const json& value, const std::string& what) {
+    if (!value.is_number()) throw BadRequest(what + ": expected a number, got " + value.dump());
+    const double number = value.get<double>();
+    if (!std::isfinite(number)) throw BadRequest(what + ": must be a finite number");
+    return number;
+}
+
+/// A colour or point from the page: [x, y, z], or one number for a grey.
+Vec3 vector_from(const json& value, const std::string& what) {
+    if (value.is_number()) return Vec3(finite_number(value, what));
+    if (!value.is_array() || value.size() != 3) throw BadRequest(what + ": expected [x, y, z] or a number");
+    return {finite_number(value[0], what), finite_number(value[1], what), finite_number(value[2], what)};
+}
+
+template <class T>
+void set(Located<T>& field, T value) {
+    field.value = value;
+    field.given = true;  // as if written in the file: the validator treats it so
+}
+
+/// Writes the page's values over the file's: {"materials": {NAME: {"kd": [r, g, b], "p": 10,
+/// ...}}, "lights": [{"intensity": ..., "position": ...}, ...]} (lights in file order).
+void apply_page_values(SceneDescription& description, const json& values) {
+    if (!values.is_object()) throw BadRequest("the values: expected a JSON object");
+    for (const auto& [key, entries] : values.items()) {
+        if (key == "materials") {
+            if (!entries.is_object()) throw BadRequest("materials: expected an object of material names");
+            for (const auto& [name, fields] : entries.items()) {
+                MaterialDescription* material = nullptr;
+                for (MaterialDescription& m : description.materials)
+                    if (m.name == name) material = &m;
+                if (!material) throw BadRequest("materials: the scene has no material named '" + name + "'");
+                if (!fields.is_object()) throw BadRequest("materials." + name + ": expected an object");
+                for (const auto& [field, value] : fields.items()) {
+                    const std::string what = "materials." + name + "." + field;
+                    if (field == "ka")
+                        set(material->ka, vector_from(value, what));
+                    else if (field == "kd")
+                        set(material->kd, vector_from(value, what));
+                    else if (field == "ks")
+                        set(material->ks, vector_from(value, what));
+                    else if (field == "km")
+                        set(material->km, vector_from(value, what));
+                    else if (field == "kt")
+                        set(material->kt, vector_from(value, what));
+                    else if (field == "p")
+                        set(material->p, finite_number(value, what));
+                    else if (field == "ior")
+                        set(material->ior, finite_number(value, what));
+                    else
+                        throw BadRequest(what + ": not a material value the page can set (ka kd ks p km kt ior)");
+                }
+            }
+        } else if (key == "lights") {
+            if (!entries.is_array() || entries.size() > description.lights.size())
+                throw BadRequest("lights: expected an array of at most " + std::to_string(description.lights.size()) +
+                                 " light(s), in file order");
+            for (size_t i = 0; i < entries.size(); ++i) {
+                if (entries[i].is_null()) continue;
+                if (!entries[i].is_object()) throw BadRequest("lights[" + std::to_string(i) + "]: expected an object");
+                LightDescription& light = description.lights[i];
+                for (const auto& [field, value] : entries[i].items()) {
+                    const std::string what = "lights[" + std::to_string(i) + "]." + field;
+                    if (field == "intensity")
+                        set(light.intensity, vector_from(value, what));
+                    else if (field == "position" && light.type == LightType::point)
+                        set(light.position, vector_from(value, what));
+                    else if (field == "direction" && light.type == LightType::directional)
+                        set(light.direction, vector_from(value, what));
+                    else
+                        throw BadRequest(what + ": not a value this light has");
+                }
+            }
+        } else {
+            throw BadRequest("'" + key + "': the page sets only materials and lights");
+        }
+    }
+}
+
+/// The scene as the page's panels show it: the file's values.
+json describe_scene(const SceneDescription& d) {
+    json materials = json::array();
+    for (const MaterialDescription& m : d.materials)
+        materials.push_back({{"name", m.name},
+                             {"where", m.where.str()},
+                             {"ka", to_json(m.ka.value)},
+                             {"kd", to_json(m.kd.value)},
+                             {"ks", to_json(m.ks.value)},
+                             {"p", m.p.value},
+                             {"km", to_json(m.km.value)},
+                             {"kt", to_json(m.kt.value)},
+                             {"ior", m.ior.value},
+                             {"highlight", m.highlight.value == Highlight::phong ? "phong" : "blinn"},
+                             {"glazed", m.fresnel_ior.given}});
+    json lights = json::array();
+    for (const LightDescription& l : d.lights) {
+        json light = {{"type", l.type == LightType::point ? "point" : "directional"},
+                      {"intensity", to_json(l.intensity.value)}};
+        if (l.type == LightType::point)
+            light["position"] = to_json(l.position.value);
+        else
+            light["direction"] = to_json(l.direction.value);
+        lights.push_back(light);
+    }
+    return {{"path", d.path},
+            {"width", d.image.width.value},
+            {"height", d.image.height.value},
+            {"samples", d.image.samples.value},
+            {"ambient", to_json(d.ambient.value)},
+            {"materials", materials},
+            {"lights", lights}};
+}
+
+/// What the server shares between its threads: the file's latest text, whether it loads, and a
+/// version the page polls to know when to render again.
+class LiveState {
+public:
+    explicit LiveState(std::string path) : m_path(std::move(path)) {}
+
+    /// Reads the file if its stamp changed since the last look; true if it did.
+    bool refresh() {
+        const FileStamp stamp = stamp_of(m_path);
+        {
+            std::lock_guard lock(m_mutex);
+            if (m_version > 0 && stamp == m_stamp) return false;
+        }
+        std::string text, error;
+        try {
+            text = read_scene_text(m_path);
+            (void)validate_scene(parse_any_scene_text(text, m_path));  // meshes included
+        } catch (const std::exception& e) {
+            error = e.what();  // an InputError says FILE:LINE:COL
+        }
+        std::lock_guard lock(m_mutex);
+        m_stamp = stamp;
+        if (error.empty()) m_text = std::move(text);
+        m_error = std::move(error);
+        ++m_version;
+        return true;
+    }
+
+    struct Snapshot {
+        std::string text, error;
+        uint64_t version = 0;
+    };
+    Snapshot snapshot() const {
+        std::lock_guard lock(m_mutex);
+        return {m_text, m_error, m_version};
+    }
+    const std::string& path() const { return m_path; }
+
+private:
+    const std::string m_path;
+    mutable std::mutex m_mutex;
+    FileStamp m_stamp;
+    std::string m_text, m_error;  // the text is the last one that loaded
+    uint64_t m_version = 0;
+};
+
+/// The render at `level` "coarse" (a quarter of the width and height, one sample per pixel: the
+/// first image while the slider moves) or "full" (the scene's own settings), as PNG through the
+/// default display transform (as `whitted render -o x.png`) or linear EXR (as `-o x.exr`).
+struct Rendered {
+    std::string bytes;
+    double render_seconds = 0;
+};
+
+Rendered render_image(const std::string& text, const std::string& path, const json& values, bool coarse, int threads,
+                      const std::filesystem::path& temp_file) {
+    auto impl = std::make_unique<api::Scene::Impl>();
+    impl->description = parse_any_scene_text(text, path);
+    apply_page_values(impl->description, values);
+    if (coarse) {
+        ImageDescription& image = impl->description.image;
+        image.width.value = std::max<int64_t>(1, image.width.value / 4);
+        image.height.value = std::max<int64_t>(1, image.height.value / 4);
+        image.samples.value = 1;
+    }
+    impl->scene = validate_scene(impl->description);
+    const api::Scene scene(std::move(impl));
+    api::RenderOptions options;
+    options.threads = threads;
+    options.layers = {"none"};  // the beauty only: the page shows it, and a PNG has no layers
+    api::Expected<api::RenderResult> result = api::render(scene, options);
+    if (!result) throw std::runtime_error(result.error().what());
+    if (const auto written = api::write_image(result->image, temp_file.string(), {}); !written)
+        throw std::runtime_error(written.error().what());
+    Rendered rendered;
+    {
+        std::ifstream in(temp_file, std::ios::binary);
+        std::ostringstream bytes;
+        bytes << in.rdbuf();
+        rendered.bytes = bytes.str();
+    }
+    std::error_code ignored;
+    std::filesystem::remove(temp_file, ignored);
+    rendered.render_seconds = result->stats.seconds;
+    return rendered;
+}
+
+void send_error(httplib::Response& response, int status, const std::string& message) {
+    response.status = status;
+    response.set_content(json{{"error", message}}.dump(), "application/json");
+}
+
+/// Opens the page in the desktop's browser (xdg-open); a machine without one only says so.
+void open_in_browser(const std::string& url) {
+    pid_t pid = 0;
+    const char* argv[] = {"xdg-open", url.c_str(), nullptr};
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+    const int error = posix_spawnp(&pid, "xdg-open", &actions, nullptr, const_cast<char* const*>(argv), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (error != 0) {
+        std::fprintf(stderr, "whitted live: could not open a browser (xdg-open: %s); open the address above\n",
+                     std::strerror(error));
+        return;
+    }
+    std::thread([pid] { ::waitpid(pid, nullptr, 0); }).detach();
+}
+
+}  // namespace
+
+int run_live(const LiveArguments& args) {
+    // SIGINT and SIGTERM go to one thread that stops the server (a handler could not): blocked
+    // here, before any thread exists, so every thread inherits the mask.
+    sigset_t stop_signals;
+    sigemptyset(&stop_signals);
+    sigaddset(&stop_signals, SIGINT);
+    sigaddset(&stop_signals, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+
+    LiveState state(args.scene);
+    state.refresh();
+    if (const std::string error = state.snapshot().error; !error.empty()) {
+        std::fprintf(stderr, "whitted: error: %s\n", error.c_str());
+        return exit_bad_input;
+    }
+
+    // The images are written through the image output code, which writes files: here, then read.
+    const char* temp_base = std::getenv("TMPDIR");
+    std::string pattern =
+        (temp_base && *temp_base ? std::string(temp_base) : std::string("/tmp")) + "/whitted-live-XXXXXX";
+    if (!::mkdtemp(pattern.data())) {
+        std::fprintf(stderr, "whitted: error: cannot make a temporary directory %s: %s\n", pattern.c_str(),
+                     std::strerror(errno));
+        return exit_failure;
+    }
+    const std::filesystem::path temp_dir = pattern;
+
+    httplib::Server server;
+    const int port = args.port > 0 ? (server.bind_to_port("127.0.0.1", args.port) ? args.port : -1)
+                                   : server.bind_to_any_port("127.0.0.1");
+    if (port <= 0) {
+        std::error_code ignored;
+        std::filesystem::remove_all(temp_dir, ignored);
+        std::fprintf(stderr, "whitted: error: --port %d: cannot listen on 127.0.0.1:%d (in use?)\n", args.port,
+                     args.port);
+        return exit_bad_input;
+    }
+    const std::string self_origin = "http://127.0.0.1:" + std::to_string(port);
+    const std::string url = self_origin + "/";
+
+    // Only this machine's pages: a Host other than ours is a DNS-rebinding page on another name,
+    // an Origin other than ours another site's script.
+    server.set_pre_routing_handler([&](const httplib::Request& request, httplib::Response& response) {
+        const std::string host = request.get_header_value("Host");
+        const std::string origin = request.get_header_value("Origin");
+        const std::string port_text = std::to_string(port);
+        const bool host_ok = host == "127.0.0.1:" + port_text || host == "localhost:" + port_text;
+        const bool origin_ok = origin.empty() || origin == self_origin || origin == "http://localhost:" + port_text;
+        if (host_ok && origin_ok) return httplib::Server::HandlerResponse::Unhandled;
+        response.status = 403;
+        response.set_content(host_ok ? "whitted live: requests from another origin are refused\n"
+                                     : "whitted live: requests for another host are refused\n",
+                             "text/plain");
+        return httplib::Server::HandlerResponse::Handled;
+    });
+
+    server.Get("/", [](const httplib::Request&, httplib::Response& response) {
+        response.set_header("Cache-Control", "no-store");
+        response.set_header("Content-Security-Policy",
+                            "default-src 'none'; img-src 'self' blob:; script-src 'unsafe-inline'; "
+                            "style-src 'unsafe-inline'; connect-src 'self'");
+        response.set_content(live_page_html, "text/html; charset=utf-8");
+    });
+    server.Get("/state", [&](const httplib::Request&, httplib::Response& response) {
+        const LiveState::Snapshot snapshot = state.snapshot();
+        response.set_header("Cache-Control", "no-store");
+        response.set_content(json{{"version", snapshot.version}, {"error", snapshot.error}}.dump(), "application/json");
+    });
+    server.Get("/scene", [&](const httplib::Request&, httplib::Response& response) {
+        const LiveState::Snapshot snapshot = state.snapshot();
+        response.set_header("Cache-Control", "no-store");
+        try {
+            json scene = describe_scene(parse_any_scene_text(snapshot.text, state.path()));
+            scene["version"] = snapshot.version;
+            response.set_content(scene.dump(), "application/json");
+        } catch (const std::exception& e) {
+            send_error(response, 422, e.what());
+        }
+    });
+    // One render at a time: two at once would only share the two cores and both be late.
+    std::mutex render_mutex;
+    uint64_t render_count = 0;
+    server.Post("/render", [&](const httplib::Request& request, httplib::Response& response) {
+        json body;
+        try {
+            body = json::parse(request.body);
+        } catch (const std::exception& e) {
+            return send_error(response, 400, std::string("the request is not JSON: ") + e.what());
+        }
+        const std::string level = body.value("level", "full"), format = body.value("format", "png");
+        if ((level != "full" && level != "coarse") || (format != "png" && format != "exr"))
+            return send_error(response, 400, "level must be full or coarse, format png or exr");
+        const LiveState::Snapshot snapshot = state.snapshot();
+        if (!snapshot.error.empty()) return send_error(response, 409, snapshot.error);
+        try {
+            std::lock_guard lock(render_mutex);
+            const std::filesystem::path file = temp_dir / ("render-" + std::to_string(++render_count) + "." + format);
+            const auto start = std::chrono::steady_clock::now();
+            const Rendered rendered = render_image(snapshot.text, state.path(), body.value("values", json::object()),
+                                                   level == "coarse", args.threads, file);
+            const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            response.set_header("X-Whitted-Version", std::to_string(snapshot.version));
+            response.set_header("X-Whitted-Render-Ms", std::to_string(int(rendered.render_seconds * 1000 + 0.5)));
+            response.set_header("X-Whitted-Total-Ms", std::to_string(int(seconds * 1000 + 0.5)));
+            response.set_header("Cache-Control", "no-store");
+            response.set_content(rendered.bytes, format == "exr" ? "image/x-exr" : "image/png");
+        } catch (const BadRequest& e) {
+            send_error(response, 400, e.what());
+        } catch (const InputError& e) {  // a page value the scene format refuses, at its place in the file
+            send_error(response, 422, e.what());
+        } catch (const std::invalid_argument& e) {
+            send_error(response, 422, e.what());
+        } catch (const std::exception& e) {
+            send_error(response, 500, e.what());
+        }
+    });
+
+    std::atomic<bool> done{false};
+    std::atomic<int> stop_signal{0};
+    std::thread watcher([&] {
+        while (!done.load()) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(200));
+            if (!done.load()) state.refresh();
+        }
+    });
+    std::thread stopper([&] {
+        const timespec poll{0, 100'000'000};
+        while (!done.load()) {
+            const int signal = sigtimedwait(&stop_signals, nullptr, &poll);
+            if (signal > 0) {
+                stop_signal.store(signal);
+                break;
+            }
+        }
+        // stop() acts only on a running server: repeated until listen() has returned.
+        while (!done.load()) {
+            server.stop();
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+    });
+
+    std::printf("whitted live: %s\n", url.c_str());
+    std::fflush(stdout);
+    if (args.open_browser) open_in_browser(url);
+    const bool listened = stop_signal.load() != 0 || server.listen_after_bind();
+    done.store(true);
+    watcher.join();
+    stopper.join();
+    std::error_code ignored;
+    std::filesystem::remove_all(temp_dir, ignored);
+    if (const int signal = stop_signal.load()) {
+        std::fprintf(stderr, "whitted live: stopped\n");
+        return 128 + signal;
+    }
+    if (!listened) {
+        std::fprintf(stderr, "whitted: error: the server on %s stopped serving\n", url.c_str());
+        return exit_failure;
+    }
+    return 0;
+}
+
+}  // namespace whitted
