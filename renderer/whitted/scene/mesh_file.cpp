@@ -50,19 +50,20 @@ const char* token_end(const char* p, const char* end) {
 
 /// OBJ and MTL have no encoding: keywords and numbers are ASCII, and names are whatever bytes
 /// the exporter wrote (Latin-1 from older tools, UTF-8 from newer). So any byte is accepted but
-/// NUL and the control bytes no text has (all below 0x20 but tab, line feed, vertical tab, form
-/// feed and carriage return), which mark a binary file; the first is named by line and column.
-/// Called only for text with a byte outside plain ASCII (is_plain_ascii), as a binary file has.
+/// NUL, DEL and the C0 control bytes other than tab, line feed and carriage return, which no text
+/// has and which mark a binary file (or could drive a terminal from a comment or a name); the
+/// first is named by line and column, in comments too. Called only for text that is not plain
+/// (is_plain_text).
 void check_text_bytes(std::string_view text, const std::string& path) {
     int line = 1, column = 1;
-    for (const char ch : text) {
-        const auto c = static_cast<unsigned char>(ch);
-        if (c == '\n') {
+    for (size_t i = 0; i < text.size(); ++i) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (ends_line(text, i)) {
             ++line, column = 1;
             continue;
         }
         if (c == 0) throw InputError({path, line, column}, "the file contains a NUL byte: is it a binary file?");
-        if (c < 0x20 && c != '\t' && c != '\v' && c != '\f' && c != '\r') {
+        if ((c < 0x20 && c != '\t' && c != '\r') || c == 0x7F) {
             char hex[8];
             std::snprintf(hex, sizeof hex, "0x%02X", unsigned(c));
             throw InputError({path, line, column},
@@ -70,6 +71,50 @@ void check_text_bytes(std::string_view text, const std::string& path) {
         }
         ++column;
     }
+}
+
+/// True when every byte is printable ASCII, a tab, a line feed or a carriage return: such text
+/// needs no closer look (check_text_bytes). Eight bytes at a time (mesh files are tens of
+/// megabytes): a word with no byte below 0x20, none at 0x7F and none above is plain at once; the
+/// others (most hold a line end) are looked at byte by byte.
+bool is_plain_text(std::string_view text) {
+    const auto* bytes = reinterpret_cast<const unsigned char*>(text.data());
+    const size_t n = text.size();
+    const auto plain_byte = [](unsigned char c) {
+        return (c >= 0x20 && c < 0x7F) || c == '\t' || c == '\n' || c == '\r';
+    };
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        uint64_t word;
+        std::memcpy(&word, bytes + i, 8);
+        constexpr uint64_t high = 0x8080808080808080ull, ones = 0x0101010101010101ull;
+        if (word & high) return false;
+        const uint64_t del = word ^ (ones * 0x7F);
+        if ((del - ones) & ~del & high) return false;  // a byte 0x7F
+        if ((word - ones * 0x20) & ~word & high)       // a byte below 0x20
+            for (size_t k = 0; k < 8; ++k)
+                if (!plain_byte(bytes[i + k])) return false;
+    }
+    for (; i < n; ++i)
+        if (!plain_byte(bytes[i])) return false;
+    return true;
+}
+
+/// The text with every CR that no LF follows made a LF: a lone CR ends a line (and so a
+/// statement) in OBJ and MTL files, as in tinyobjloader (its safeGetline) and Assimp, and as CR,
+/// LF and CRLF all end lines in every text format Whitted reads (ends_line). The byte count stays
+/// the same, so every column is what it was. `storage` holds the copy, made only when the text
+/// has a lone CR (CRLF files are read as they are: a CR is blank before the LF).
+std::string_view with_lone_carriage_returns_as_line_feeds(std::string_view text, std::string& storage) {
+    const char* const end = text.data() + text.size();
+    const char* p = text.data();
+    for (; (p = static_cast<const char*>(std::memchr(p, '\r', size_t(end - p)))); ++p)
+        if (p + 1 == end || p[1] != '\n') break;
+    if (!p) return text;
+    storage.assign(text);
+    for (size_t i = size_t(p - text.data()); i < storage.size(); ++i)
+        if (storage[i] == '\r' && (i + 1 == storage.size() || storage[i + 1] != '\n')) storage[i] = '\n';
+    return storage;
 }
 
 /// The text without a leading UTF-8 byte-order mark (some Windows tools write one; it is not
@@ -292,8 +337,10 @@ Color read_color(LineReader& line, const char* what) {
 void read_mtl(const std::string& path, std::vector<MaterialDescription>& materials,
               std::unordered_map<std::string, int32_t>& by_name, std::vector<std::string>& warnings) {
     const std::string file_text = read_text_file(path, limits::max_mesh_file_bytes, "MTL file");
-    const std::string_view text = without_byte_order_mark(file_text, path);
-    if (!is_plain_ascii(text)) check_text_bytes(text, path);
+    std::string line_feeds;
+    const std::string_view text =
+        with_lone_carriage_returns_as_line_feeds(without_byte_order_mark(file_text, path), line_feeds);
+    if (!is_plain_text(text)) check_text_bytes(text, path);
     MaterialDescription* current = nullptr;
     for_each_statement(path, text, [&](LineReader& line, std::string_view keyword) {
         if (keyword == "newmtl") {
@@ -365,10 +412,10 @@ struct Lines {
     int first_line = 1;
     size_t newlines = 0, positions = 0, normals = 0, faces = 0;
     bool materials = false;  ///< has usemtl or mtllib, which carry state from line to line
-    bool plain_ascii = true;
+    bool plain_text = true;  ///< no byte that check_text_bytes must look at
 
     void count() {
-        plain_ascii = is_plain_ascii(text);
+        plain_text = is_plain_text(text);
         const char* const end = text.data() + text.size();
         for (const char* p = text.data(); p < end;) {
             const char* keyword = skip_blanks(p, end);
@@ -936,7 +983,7 @@ std::optional<ObjContents> read_obj(const std::string& path, std::string_view te
     std::vector<Lines> runs = split_lines(text, parts);
     tbb::parallel_for(size_t(0), runs.size(), [&](size_t k) { runs[k].count(); });
     for (const Lines& run : runs)
-        if (!run.plain_ascii) {
+        if (!run.plain_text) {
             check_text_bytes(text, path);  // refuses binary files, names the line
             break;
         }
@@ -1156,7 +1203,9 @@ MeshData load_obj_mesh(const std::string& path, const SourceLocation& referenced
     if (!std::filesystem::is_regular_file(status))
         throw InputError(referenced_at, "mesh file '" + path + "' is not a regular file");
     const MappedTextFile file(path, limits::max_mesh_file_bytes, "mesh file");
-    const std::string_view text = without_byte_order_mark(file.text(), path);
+    std::string line_feeds;
+    const std::string_view text =
+        with_lone_carriage_returns_as_line_feeds(without_byte_order_mark(file.text(), path), line_feeds);
     // Large files are read by every core at once, a run of lines each (below a few megabytes
     // the threads would cost more than they save).
     if (parts <= 0) {
