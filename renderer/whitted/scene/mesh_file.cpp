@@ -899,16 +899,37 @@ void resolve_materials(const std::string& path, ObjContents& contents) {
 /// at this size on one core).
 constexpr size_t max_concave_corners = 20000;
 
+/// The ear clipping of one OBJ file, counted as triangulate_polygon's bound of n²/2 corner-in-
+/// triangle tests per face: two faces at the corner limit (each face is bounded, but ten of them
+/// took 25 s). Faces past it keep the fan from their first corner, with one warning.
+constexpr uint64_t max_ear_clipping_tests_per_file = 400'000'000;
+
 /// Looks again at every polygon, fanned while reading: where the fan is wrong (the polygon is
-/// not convex) its n − 2 triangles are replaced by triangulate_polygon's, in place. The
-/// polygons are independent, so the cores share them; the result does not depend on how.
+/// not convex) its n − 2 triangles are replaced by triangulate_polygon's, in place, while the
+/// file's budget of ear clipping lasts (granted in file order). The polygons are independent, so
+/// the cores share them; the result does not depend on how.
 void triangulate_polygons(const std::string& path, const std::vector<float>& positions,
                           const std::vector<Polygon>& polygons, std::vector<uint32_t>& indices,
-                          std::vector<uint32_t>& normal_index) {
+                          std::vector<uint32_t>& normal_index, std::vector<std::string>& warnings) {
     if (polygons.empty()) return;
-    std::atomic<size_t> first_refused{polygons.size()};
+    // The fan (0, j, j+1) for j = 1 … n−2 names corner 0, corner 1, then one more each.
+    const auto fan_corners = [&](const Polygon& polygon, const std::vector<uint32_t>& index,
+                                 std::vector<uint32_t>& out) {
+        const size_t n = polygon.corners, t0 = polygon.first_triangle;
+        out.assign({index[3 * t0], index[3 * t0 + 1]});
+        for (size_t j = 0; j + 2 < n; ++j) out.push_back(index[3 * (t0 + j) + 2]);
+    };
+    const auto corners_of = [&](const std::vector<uint32_t>& position_of, std::vector<Vec3>& corners) {
+        corners.resize(position_of.size());
+        for (size_t c = 0; c < position_of.size(); ++c) {
+            const float* xyz = &positions[3 * size_t(position_of[c])];
+            corners[c] = {xyz[0], xyz[1], xyz[2]};
+        }
+    };
+    // Which polygons the fan does not cover.
+    std::vector<char> needs_ears(polygons.size(), 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, polygons.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-        std::vector<uint32_t> position_of, normal_of;
+        std::vector<uint32_t> position_of;
         std::vector<Vec3> corners;
         PlanarPolygon plane;
         for (size_t k = r.begin(); k != r.end(); ++k) {
@@ -925,40 +946,56 @@ void triangulate_polygons(const std::string& path, const std::vector<float>& pos
                 const Vec3 p0 = at(3 * t0), p1 = at(3 * t0 + 1), p2 = at(3 * t0 + 2), p3 = at(3 * t0 + 5);
                 if (dot(cross(p1 - p0, p2 - p0), cross(p2 - p0, p3 - p0)) > 0) continue;
             }
-            // The fan (0, j, j+1) for j = 1 … n−2 names corner 0, corner 1, then one more each.
-            const auto fan_corners = [&](const std::vector<uint32_t>& index, std::vector<uint32_t>& out) {
-                out.assign({index[3 * t0], index[3 * t0 + 1]});
-                for (size_t j = 0; j + 2 < n; ++j) out.push_back(index[3 * (t0 + j) + 2]);
-            };
-            fan_corners(indices, position_of);
-            corners.resize(n);
-            for (size_t c = 0; c < n; ++c) {
-                const float* xyz = &positions[3 * size_t(position_of[c])];
-                corners[c] = {xyz[0], xyz[1], xyz[2]};
-            }
+            fan_corners(polygon, indices, position_of);
+            corners_of(position_of, corners);
             plane.set(corners);
-            if (plane.is_convex()) continue;  // the fan is right
-            if (n > max_concave_corners) {
-                size_t seen = first_refused.load();
-                while (k < seen && !first_refused.compare_exchange_weak(seen, k)) {
-                }
-                continue;
-            }
+            needs_ears[k] = !plane.is_convex();
+        }
+    });
+    // In file order, so that which faces get ears does not depend on the threads: the first face
+    // too large to cut is refused; the others are cut while the budget lasts.
+    uint64_t granted = 0;
+    size_t fanned = 0, first_fanned = 0;
+    for (size_t k = 0; k < polygons.size(); ++k) {
+        if (!needs_ears[k]) continue;
+        const Polygon& polygon = polygons[k];
+        if (polygon.corners > max_concave_corners)
+            throw InputError({path, polygon.line, 1}, "a face of " + count_of(polygon.corners, "corner") +
+                                                          " that is not convex; Whitted triangulates such faces of up "
+                                                          "to " +
+                                                          std::to_string(max_concave_corners) + " corners");
+        const uint64_t tests = uint64_t(polygon.corners) * polygon.corners / 2;
+        if (granted + tests <= max_ear_clipping_tests_per_file) {
+            granted += tests;
+        } else {
+            needs_ears[k] = 0;
+            if (fanned++ == 0) first_fanned = k;
+        }
+    }
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, polygons.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<uint32_t> position_of, normal_of;
+        std::vector<Vec3> corners;
+        for (size_t k = r.begin(); k != r.end(); ++k) {
+            if (!needs_ears[k]) continue;
+            const Polygon& polygon = polygons[k];
+            fan_corners(polygon, indices, position_of);
+            corners_of(position_of, corners);
             const std::vector<uint32_t> triangles = triangulate_polygon(corners);
-            if (!normal_index.empty()) fan_corners(normal_index, normal_of);
+            if (!normal_index.empty()) fan_corners(polygon, normal_index, normal_of);
+            const size_t t0 = polygon.first_triangle;
             for (size_t c = 0; c < triangles.size(); ++c) {
                 indices[3 * t0 + c] = position_of[triangles[c]];
                 if (!normal_index.empty()) normal_index[3 * t0 + c] = normal_of[triangles[c]];
             }
         }
     });
-    if (first_refused < polygons.size()) {
-        const Polygon& polygon = polygons[first_refused];
-        throw InputError({path, polygon.line, 1}, "a face of " + count_of(polygon.corners, "corner") +
-                                                      " that is not convex; Whitted "
-                                                      "triangulates such faces of up to " +
-                                                      std::to_string(max_concave_corners) + " corners");
-    }
+    if (fanned > 0)
+        warnings.push_back(SourceLocation{path, polygons[first_fanned].line, 1}.str() + ": " +
+                           count_of(int64_t(fanned), "face") + (fanned == 1 ? " that is" : " that are") +
+                           " not convex, from this one on, keep the fan from the first corner (which may "
+                           "cover more or less than the face): cutting them into ears would pass the file's limit of " +
+                           std::to_string(max_ear_clipping_tests_per_file) +
+                           " corner tests (n²/2 for a face of n corners)");
 }
 
 /// Splits `text` into at most `parts` runs of whole lines of roughly equal size.
@@ -1063,7 +1100,7 @@ std::optional<ObjContents> read_obj(const std::string& path, std::string_view te
         }
     }
 
-    triangulate_polygons(path, mesh.positions, polygons, mesh.indices, normal_index);
+    triangulate_polygons(path, mesh.positions, polygons, mesh.indices, normal_index, mesh.warnings);
 
     const bool smooth = every_corner_has_normal && normals > 0;
     if (!smooth) return contents;
