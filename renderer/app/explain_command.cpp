@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
@@ -327,6 +328,21 @@ nlohmann::json to_json(const Scene& scene, const std::string& path, const PixelE
               {"beauty", {double(e.layer_beauty[0]), double(e.layer_beauty[1]), double(e.layer_beauty[2])}}}}};
 }
 
+/// JSON has no number for infinity or NaN (nlohmann writes them as null, which the schema
+/// refuses): a legal scene can still produce them (a colour of 1e300 overflows the float pixel),
+/// so each is written as the string "inf", "-inf" or "nan", as docs/explain.schema.json allows.
+void name_non_finite_numbers(nlohmann::json& j) {
+    if (j.is_number_float()) {
+        const double d = j.get<double>();
+        if (std::isnan(d))
+            j = "nan";
+        else if (std::isinf(d))
+            j = d > 0 ? "inf" : "-inf";
+    } else if (j.is_structured()) {
+        for (nlohmann::json& child : j) name_non_finite_numbers(child);
+    }
+}
+
 void print_error(const std::string& message) {
     std::fprintf(stderr, "whitted: error: %s\n", message.c_str());
 }
@@ -355,13 +371,13 @@ int run_explain(const std::string& scene_path, const std::string& pixel, bool js
     try {
         const Accelerator accelerator(scene, threads);
         const PixelExplanation explanation = explain_pixel(scene, accelerator, x, y);
-        if (json)
+        if (json) {
             // Names may be Latin-1 (MTL files): bytes that are not UTF-8 are written as U+FFFD, so
             // that the output is JSON whatever the scene holds.
-            std::printf("%s\n", to_json(scene, scene_path, explanation)
-                                    .dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
-                                    .c_str());
-        else if (summary)
+            nlohmann::json document = to_json(scene, scene_path, explanation);
+            name_non_finite_numbers(document);
+            std::printf("%s\n", document.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+        } else if (summary)
             print_summary(scene, scene_path, explanation);
         else
             print_text(scene, scene_path, explanation);

@@ -353,6 +353,53 @@ def case_explain(whitted, scene_dir, out_dir):
           f"own terms ({blocked} blocked shadow rays named, {mirrored} mirror rays)")
 
 
+OVERFLOW_NFF = """v
+from 0 0 10
+at 0 0 0
+up 0 1 0
+angle 45
+hither 0.01
+resolution 16 12
+b 0 0 0
+l 5 5 5 1e300 1e300 1e300
+f 1e300 1e300 1e300 1 0 10 0 1
+s 0 0 0 2
+"""
+
+
+def non_finite_strings(value):
+    """Every "inf", "-inf" or "nan" string in a decoded JSON document."""
+    if isinstance(value, str):
+        return [value] if value in ("inf", "-inf", "nan") else []
+    if isinstance(value, list):
+        return [s for item in value for s in non_finite_strings(item)]
+    if isinstance(value, dict):
+        return [s for item in value.values() for s in non_finite_strings(item)]
+    return []
+
+
+def case_overflow(whitted, out_dir):
+    """A legal scene whose light and colour are 1e300 overflows the float pixel to +inf (and
+    products of inf and 0 give NaN); JSON has no such numbers, so explain --json writes the
+    strings the schema allows instead of null (which failed the schema 30 times)."""
+    scene = os.path.join(out_dir, "overflow.nff")
+    with open(scene, "w") as f:
+        f.write(OVERFLOW_NFF)
+    import jsonschema
+    schema_path = os.path.join(os.path.dirname(__file__), "..", "..", "docs", "explain.schema.json")
+    schema = json.load(open(schema_path))
+    text = run([whitted, "explain", scene, "--pixel", "8,6", "--json"]).stdout
+    if "null" in text.replace('"shadow_ray": null', "").replace('"blocker": null', "").replace(
+            '"mirror": null', "").replace('"refracted": null', ""):
+        sys.exit(f"FAIL: explain --json wrote a number as null:\n{text[:3000]}")
+    e = json.loads(text)
+    jsonschema.validate(e, schema)
+    named = non_finite_strings(e)
+    if e["layers"]["beauty"] != ["inf", "inf", "inf"] or e["rgb"] != ["inf", "inf", "inf"]:
+        sys.exit(f"FAIL: the overflowing pixel is {e['rgb']} (layers: {e['layers']['beauty']}), expected inf")
+    print(f"ok overflow: the document validates; {len(named)} non-finite values written as strings")
+
+
 def case_usage(whitted, out_dir):
     scene = os.path.join(out_dir, "usage.yaml")
     with open(scene, "w") as f:
@@ -405,6 +452,8 @@ def main():
         case_names(whitted, out_dir)
     elif case == "explain":
         case_explain(whitted, scene_dir, out_dir)
+    elif case == "overflow":
+        case_overflow(whitted, out_dir)
     elif case == "usage":
         case_usage(whitted, out_dir)
     else:

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -179,6 +180,52 @@ TEST(Triangulate, APolygonThatCrossesItselfAtTheCornerLimitGetsItsTriangles) {
         if (t + 3 < triangles.size()) ++tips[triangles[t + 1]];
     }
     EXPECT_EQ(*std::max_element(tips.begin(), tips.end()), 1) << "a corner was cut off twice";
+}
+
+/// An OBJ file of `faces` faces of `n` corners each at random points of a 100 × 100 grid (each
+/// crosses itself everywhere: the ear clipping's worst case).
+std::string crossing_faces_obj(int faces, int n) {
+    std::mt19937 random(4620);
+    std::uniform_int_distribution<int> coordinate(0, 99);
+    std::string text;
+    for (int i = 0; i < faces * n; ++i)
+        text += "v " + std::to_string(coordinate(random)) + " " + std::to_string(coordinate(random)) + " 0\n";
+    for (int f = 0; f < faces; ++f) {
+        text += "f";
+        for (int c = 0; c < n; ++c) text += " " + std::to_string(f * n + c + 1);
+        text += "\n";
+    }
+    return text;
+}
+
+TEST(Triangulate, AFileOfManyLargeFacesIsCutWithinOneBudget) {
+    // Each face is bounded (n²/2 corner tests) but a file was not: ten faces of 19,999 corners
+    // took 25 s. The file's ear clipping is bounded at 4e8 tests, two such faces: the other eight
+    // keep their fan, named in one warning, and every face still has its n − 2 triangles.
+    constexpr int n = 19999;
+    const test::ScratchDirectory directory;
+    const std::string one = directory.write("one.obj", crossing_faces_obj(1, n));
+    const std::string ten = directory.write("ten.obj", crossing_faces_obj(10, n));
+    const auto seconds_to_load = [](const std::string& path, MeshData& mesh) {
+        const auto start = std::chrono::steady_clock::now();
+        mesh = load_obj_mesh(path, {}, 0, false);  // no MTL: no warnings of faces without usemtl
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
+    MeshData mesh_one, mesh_ten;
+    const double t_one = seconds_to_load(one, mesh_one), t_ten = seconds_to_load(ten, mesh_ten);
+    EXPECT_TRUE(mesh_one.warnings.empty()) << mesh_one.warnings.front();
+    ASSERT_EQ(mesh_ten.warnings.size(), 1u);
+    EXPECT_THAT(mesh_ten.warnings[0], HasSubstr(ten + ":" + std::to_string(10 * n + 3) +
+                                                ":1: 8 faces that are not convex, from this one on, keep the fan"));
+    EXPECT_EQ(mesh_ten.indices.size(), size_t(10) * 3 * (n - 2));
+    // Ears for the first face, the same as alone (the same corners); the fan for the third.
+    for (size_t c = 0; c < mesh_one.indices.size(); ++c) ASSERT_EQ(mesh_ten.indices[c] % n, mesh_one.indices[c]);
+    const size_t third = size_t(2) * 3 * (n - 2);
+    EXPECT_EQ(mesh_ten.indices[third], uint32_t(2 * n));
+    EXPECT_EQ(mesh_ten.indices[third + 1], uint32_t(2 * n + 1));
+    EXPECT_EQ(mesh_ten.indices[third + 2], uint32_t(2 * n + 2));
+    // Ten faces cost about two faces' ear clipping, not ten (a ratio, measured in one run).
+    EXPECT_LT(t_ten, 5 * t_one) << "one face: " << t_one << " s, ten: " << t_ten << " s";
 }
 
 TEST(Triangulate, CollinearAndRepeatedCorners) {

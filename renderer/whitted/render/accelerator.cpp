@@ -775,13 +775,58 @@ struct Accelerator::Impl {
         const Camera& camera = scene.camera;
         const auto largest = [](const Vec3& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); };
         const double origins = std::max(finite_reach, largest(camera.eye) + largest(camera.right) + largest(camera.up));
-        for (const Instance& instance : scene.instances) {
-            const Prototype& prototype = scene.prototypes[instance.prototype];
-            const Transform& to_world = instance.object_to_world;
+        // How far from the origin of an object's own space the rays start there.
+        const auto origins_in_own_space = [&](const Transform& to_world) {
             const double shrink = largest(to_world.inverse_vector({1, 0, 0})) +
                                   largest(to_world.inverse_vector({0, 1, 0})) +
                                   largest(to_world.inverse_vector({0, 0, 1}));
-            const double in_prototype = shrink * origins + largest(to_world.inverse_point({0, 0, 0}));
+            return shrink * origins + largest(to_world.inverse_point({0, 0, 0}));
+        };
+        // A sphere, box or cone with a transform is intersected in its own space too, in double:
+        // where rays start beyond 1e17 there, a double no longer places a hit on a shape of size 1
+        // (its spacing is 16 at 1e17), so a box flattened by 1e-30 under a camera 5 away, or a
+        // sphere of radius 1e30 scaled by 1e-30, drew something else than POV-Ray (48 % and 80 %
+        // of the pixels alike). The instances' rule (below) refuses them, naming the object.
+        const auto check_own_space = [&](const SharedTransform& to_world, const Vec3& own_lo, const Vec3& own_hi,
+                                         uint32_t object) {
+            if (!to_world) return;
+            const SourceLocation where = object > 0 && object <= scene.objects.size()
+                                             ? scene.objects[object - 1].where
+                                             : SourceLocation{scene.path, 0, 0};
+            const std::string kind =
+                object > 0 && object <= scene.objects.size() ? to_string(scene.objects[object - 1].type) : "object";
+            char figure[32];
+            const double own_reach = std::max(largest(own_lo), largest(own_hi));
+            if (!(own_reach <= max_reach)) {
+                std::snprintf(figure, sizeof figure, "%g", own_reach);
+                throw InputError(where, kind + " reaches " + figure +
+                                            " from the origin of its own space (before its transform); Whitted "
+                                            "renders shapes within 1e15 of it (give the shape its size in its own "
+                                            "numbers, not through the transform)");
+            }
+            const double in_own_space = origins_in_own_space(*to_world);
+            if (!(in_own_space <= max_instance_origin)) {
+                std::snprintf(figure, sizeof figure, "%g", in_own_space);
+                throw InputError(where, kind + ": its transform shrinks or flattens it so far that rays reach " +
+                                            figure +
+                                            " in its own space; Whitted keeps them within 1e17 (give the shape "
+                                            "its size in its own numbers, not through the transform)");
+            }
+        };
+        for (const Sphere& sphere : scene.spheres)
+            check_own_space(sphere.object_to_world, sphere.center - Vec3(sphere.radius),
+                            sphere.center + Vec3(sphere.radius), sphere.object);
+        for (const Box& box : scene.boxes) check_own_space(box.object_to_world, box.min, box.max, box.object);
+        for (const Cone& cone : scene.cones) {
+            Cone own = cone;
+            own.object_to_world = nullptr;
+            world_bounds(own, lo, hi);
+            check_own_space(cone.object_to_world, lo, hi, cone.object);
+        }
+        for (const Instance& instance : scene.instances) {
+            const Prototype& prototype = scene.prototypes[instance.prototype];
+            const Transform& to_world = instance.object_to_world;
+            const double in_prototype = origins_in_own_space(to_world);
             // The other way: a prototype of ±1e-20 enlarged by 1e20 aborted in Embree too (its rays'
             // directions shrink by as much in its space), while 1e19 rendered.
             const double grow = largest(to_world.apply_vector({1, 0, 0})) + largest(to_world.apply_vector({0, 1, 0})) +

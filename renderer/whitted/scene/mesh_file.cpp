@@ -54,19 +54,20 @@ const char* token_end(const char* p, const char* end) {
 
 /// OBJ and MTL have no encoding: keywords and numbers are ASCII, and names are whatever bytes
 /// the exporter wrote (Latin-1 from older tools, UTF-8 from newer). So any byte is accepted but
-/// NUL and the control bytes no text has (all below 0x20 but tab, line feed, vertical tab, form
-/// feed and carriage return), which mark a binary file; the first is named by line and column.
-/// Called only for text with a byte outside plain ASCII (is_plain_ascii), as a binary file has.
+/// NUL, DEL and the C0 control bytes other than tab, line feed and carriage return, which no text
+/// has and which mark a binary file (or could drive a terminal from a comment or a name); the
+/// first is named by line and column, in comments too. Called only for text that is not plain
+/// (is_plain_text).
 void check_text_bytes(std::string_view text, const std::string& path) {
     int line = 1, column = 1;
-    for (const char ch : text) {
-        const auto c = static_cast<unsigned char>(ch);
-        if (c == '\n') {
+    for (size_t i = 0; i < text.size(); ++i) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (ends_line(text, i)) {
             ++line, column = 1;
             continue;
         }
         if (c == 0) throw InputError({path, line, column}, "the file contains a NUL byte: is it a binary file?");
-        if (c < 0x20 && c != '\t' && c != '\v' && c != '\f' && c != '\r') {
+        if ((c < 0x20 && c != '\t' && c != '\r') || c == 0x7F) {
             char hex[8];
             std::snprintf(hex, sizeof hex, "0x%02X", unsigned(c));
             throw InputError({path, line, column},
@@ -74,6 +75,50 @@ void check_text_bytes(std::string_view text, const std::string& path) {
         }
         ++column;
     }
+}
+
+/// True when every byte is printable ASCII, a tab, a line feed or a carriage return: such text
+/// needs no closer look (check_text_bytes). Eight bytes at a time (mesh files are tens of
+/// megabytes): a word with no byte below 0x20, none at 0x7F and none above is plain at once; the
+/// others (most hold a line end) are looked at byte by byte.
+bool is_plain_text(std::string_view text) {
+    const auto* bytes = reinterpret_cast<const unsigned char*>(text.data());
+    const size_t n = text.size();
+    const auto plain_byte = [](unsigned char c) {
+        return (c >= 0x20 && c < 0x7F) || c == '\t' || c == '\n' || c == '\r';
+    };
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        uint64_t word;
+        std::memcpy(&word, bytes + i, 8);
+        constexpr uint64_t high = 0x8080808080808080ull, ones = 0x0101010101010101ull;
+        if (word & high) return false;
+        const uint64_t del = word ^ (ones * 0x7F);
+        if ((del - ones) & ~del & high) return false;  // a byte 0x7F
+        if ((word - ones * 0x20) & ~word & high)       // a byte below 0x20
+            for (size_t k = 0; k < 8; ++k)
+                if (!plain_byte(bytes[i + k])) return false;
+    }
+    for (; i < n; ++i)
+        if (!plain_byte(bytes[i])) return false;
+    return true;
+}
+
+/// The text with every CR that no LF follows made a LF: a lone CR ends a line (and so a
+/// statement) in OBJ and MTL files, as in tinyobjloader (its safeGetline) and Assimp, and as CR,
+/// LF and CRLF all end lines in every text format Whitted reads (ends_line). The byte count stays
+/// the same, so every column is what it was. `storage` holds the copy, made only when the text
+/// has a lone CR (CRLF files are read as they are: a CR is blank before the LF).
+std::string_view with_lone_carriage_returns_as_line_feeds(std::string_view text, std::string& storage) {
+    const char* const end = text.data() + text.size();
+    const char* p = text.data();
+    for (; (p = static_cast<const char*>(std::memchr(p, '\r', size_t(end - p)))); ++p)
+        if (p + 1 == end || p[1] != '\n') break;
+    if (!p) return text;
+    storage.assign(text);
+    for (size_t i = size_t(p - text.data()); i < storage.size(); ++i)
+        if (storage[i] == '\r' && (i + 1 == storage.size() || storage[i + 1] != '\n')) storage[i] = '\n';
+    return storage;
 }
 
 /// The text without a leading UTF-8 byte-order mark (some Windows tools write one; it is not
@@ -296,8 +341,10 @@ Color read_color(LineReader& line, const char* what) {
 void read_mtl(const std::string& path, std::vector<MaterialDescription>& materials,
               std::unordered_map<std::string, int32_t>& by_name, std::vector<std::string>& warnings) {
     const std::string file_text = read_text_file(path, limits::max_mesh_file_bytes, "MTL file");
-    const std::string_view text = without_byte_order_mark(file_text, path);
-    if (!is_plain_ascii(text)) check_text_bytes(text, path);
+    std::string line_feeds;
+    const std::string_view text =
+        with_lone_carriage_returns_as_line_feeds(without_byte_order_mark(file_text, path), line_feeds);
+    if (!is_plain_text(text)) check_text_bytes(text, path);
     MaterialDescription* current = nullptr;
     for_each_statement(path, text, [&](LineReader& line, std::string_view keyword) {
         if (keyword == "newmtl") {
@@ -369,10 +416,10 @@ struct Lines {
     int first_line = 1;
     size_t newlines = 0, positions = 0, normals = 0, faces = 0;
     bool materials = false;  ///< has usemtl or mtllib, which carry state from line to line
-    bool plain_ascii = true;
+    bool plain_text = true;  ///< no byte that check_text_bytes must look at
 
     void count() {
-        plain_ascii = is_plain_ascii(text);
+        plain_text = is_plain_text(text);
         const char* const end = text.data() + text.size();
         for (const char* p = text.data(); p < end;) {
             const char* keyword = skip_blanks(p, end);
@@ -861,16 +908,37 @@ void resolve_materials(const std::string& path, ObjContents& contents) {
 /// at this size on one core).
 constexpr size_t max_concave_corners = 20000;
 
+/// The ear clipping of one OBJ file, counted as triangulate_polygon's bound of n²/2 corner-in-
+/// triangle tests per face: two faces at the corner limit (each face is bounded, but ten of them
+/// took 25 s). Faces past it keep the fan from their first corner, with one warning.
+constexpr uint64_t max_ear_clipping_tests_per_file = 400'000'000;
+
 /// Looks again at every polygon, fanned while reading: where the fan is wrong (the polygon is
-/// not convex) its n − 2 triangles are replaced by triangulate_polygon's, in place. The
-/// polygons are independent, so the cores share them; the result does not depend on how.
+/// not convex) its n − 2 triangles are replaced by triangulate_polygon's, in place, while the
+/// file's budget of ear clipping lasts (granted in file order). The polygons are independent, so
+/// the cores share them; the result does not depend on how.
 void triangulate_polygons(const std::string& path, const std::vector<float>& positions,
                           const std::vector<Polygon>& polygons, std::vector<uint32_t>& indices,
-                          std::vector<uint32_t>& normal_index) {
+                          std::vector<uint32_t>& normal_index, std::vector<std::string>& warnings) {
     if (polygons.empty()) return;
-    std::atomic<size_t> first_refused{polygons.size()};
+    // The fan (0, j, j+1) for j = 1 … n−2 names corner 0, corner 1, then one more each.
+    const auto fan_corners = [&](const Polygon& polygon, const std::vector<uint32_t>& index,
+                                 std::vector<uint32_t>& out) {
+        const size_t n = polygon.corners, t0 = polygon.first_triangle;
+        out.assign({index[3 * t0], index[3 * t0 + 1]});
+        for (size_t j = 0; j + 2 < n; ++j) out.push_back(index[3 * (t0 + j) + 2]);
+    };
+    const auto corners_of = [&](const std::vector<uint32_t>& position_of, std::vector<Vec3>& corners) {
+        corners.resize(position_of.size());
+        for (size_t c = 0; c < position_of.size(); ++c) {
+            const float* xyz = &positions[3 * size_t(position_of[c])];
+            corners[c] = {xyz[0], xyz[1], xyz[2]};
+        }
+    };
+    // Which polygons the fan does not cover.
+    std::vector<char> needs_ears(polygons.size(), 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, polygons.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-        std::vector<uint32_t> position_of, normal_of;
+        std::vector<uint32_t> position_of;
         std::vector<Vec3> corners;
         PlanarPolygon plane;
         for (size_t k = r.begin(); k != r.end(); ++k) {
@@ -887,40 +955,56 @@ void triangulate_polygons(const std::string& path, const std::vector<float>& pos
                 const Vec3 p0 = at(3 * t0), p1 = at(3 * t0 + 1), p2 = at(3 * t0 + 2), p3 = at(3 * t0 + 5);
                 if (dot(cross(p1 - p0, p2 - p0), cross(p2 - p0, p3 - p0)) > 0) continue;
             }
-            // The fan (0, j, j+1) for j = 1 … n−2 names corner 0, corner 1, then one more each.
-            const auto fan_corners = [&](const std::vector<uint32_t>& index, std::vector<uint32_t>& out) {
-                out.assign({index[3 * t0], index[3 * t0 + 1]});
-                for (size_t j = 0; j + 2 < n; ++j) out.push_back(index[3 * (t0 + j) + 2]);
-            };
-            fan_corners(indices, position_of);
-            corners.resize(n);
-            for (size_t c = 0; c < n; ++c) {
-                const float* xyz = &positions[3 * size_t(position_of[c])];
-                corners[c] = {xyz[0], xyz[1], xyz[2]};
-            }
+            fan_corners(polygon, indices, position_of);
+            corners_of(position_of, corners);
             plane.set(corners);
-            if (plane.is_convex()) continue;  // the fan is right
-            if (n > max_concave_corners) {
-                size_t seen = first_refused.load();
-                while (k < seen && !first_refused.compare_exchange_weak(seen, k)) {
-                }
-                continue;
-            }
+            needs_ears[k] = !plane.is_convex();
+        }
+    });
+    // In file order, so that which faces get ears does not depend on the threads: the first face
+    // too large to cut is refused; the others are cut while the budget lasts.
+    uint64_t granted = 0;
+    size_t fanned = 0, first_fanned = 0;
+    for (size_t k = 0; k < polygons.size(); ++k) {
+        if (!needs_ears[k]) continue;
+        const Polygon& polygon = polygons[k];
+        if (polygon.corners > max_concave_corners)
+            throw InputError({path, polygon.line, 1}, "a face of " + count_of(polygon.corners, "corner") +
+                                                          " that is not convex; Whitted triangulates such faces of up "
+                                                          "to " +
+                                                          std::to_string(max_concave_corners) + " corners");
+        const uint64_t tests = uint64_t(polygon.corners) * polygon.corners / 2;
+        if (granted + tests <= max_ear_clipping_tests_per_file) {
+            granted += tests;
+        } else {
+            needs_ears[k] = 0;
+            if (fanned++ == 0) first_fanned = k;
+        }
+    }
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, polygons.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<uint32_t> position_of, normal_of;
+        std::vector<Vec3> corners;
+        for (size_t k = r.begin(); k != r.end(); ++k) {
+            if (!needs_ears[k]) continue;
+            const Polygon& polygon = polygons[k];
+            fan_corners(polygon, indices, position_of);
+            corners_of(position_of, corners);
             const std::vector<uint32_t> triangles = triangulate_polygon(corners);
-            if (!normal_index.empty()) fan_corners(normal_index, normal_of);
+            if (!normal_index.empty()) fan_corners(polygon, normal_index, normal_of);
+            const size_t t0 = polygon.first_triangle;
             for (size_t c = 0; c < triangles.size(); ++c) {
                 indices[3 * t0 + c] = position_of[triangles[c]];
                 if (!normal_index.empty()) normal_index[3 * t0 + c] = normal_of[triangles[c]];
             }
         }
     });
-    if (first_refused < polygons.size()) {
-        const Polygon& polygon = polygons[first_refused];
-        throw InputError({path, polygon.line, 1}, "a face of " + count_of(polygon.corners, "corner") +
-                                                      " that is not convex; Whitted "
-                                                      "triangulates such faces of up to " +
-                                                      std::to_string(max_concave_corners) + " corners");
-    }
+    if (fanned > 0)
+        warnings.push_back(SourceLocation{path, polygons[first_fanned].line, 1}.str() + ": " +
+                           count_of(int64_t(fanned), "face") + (fanned == 1 ? " that is" : " that are") +
+                           " not convex, from this one on, keep the fan from the first corner (which may "
+                           "cover more or less than the face): cutting them into ears would pass the file's limit of " +
+                           std::to_string(max_ear_clipping_tests_per_file) +
+                           " corner tests (n²/2 for a face of n corners)");
 }
 
 /// Splits `text` into at most `parts` runs of whole lines of roughly equal size.
@@ -945,7 +1029,7 @@ std::optional<ObjContents> read_obj(const std::string& path, std::string_view te
     std::vector<Lines> runs = split_lines(text, parts);
     tbb::parallel_for(size_t(0), runs.size(), [&](size_t k) { runs[k].count(); });
     for (const Lines& run : runs)
-        if (!run.plain_ascii) {
+        if (!run.plain_text) {
             check_text_bytes(text, path);  // refuses binary files, names the line
             break;
         }
@@ -1025,7 +1109,7 @@ std::optional<ObjContents> read_obj(const std::string& path, std::string_view te
         }
     }
 
-    triangulate_polygons(path, mesh.positions, polygons, mesh.indices, normal_index);
+    triangulate_polygons(path, mesh.positions, polygons, mesh.indices, normal_index, mesh.warnings);
 
     const bool smooth = every_corner_has_normal && normals > 0;
     if (!smooth) return contents;
@@ -1167,7 +1251,9 @@ MeshData load_obj_mesh(const std::string& path, const SourceLocation& referenced
     const MappedTextFile file(path, limits::max_mesh_file_bytes, "mesh file");
     // Through read(): a file truncated while the parts are read is an error, never SIGBUS.
     return file.read([&]() -> MeshData {
-        const std::string_view text = without_byte_order_mark(file.text(), path);
+        std::string line_feeds;
+        const std::string_view text =
+            with_lone_carriage_returns_as_line_feeds(without_byte_order_mark(file.text(), path), line_feeds);
         // Large files are read by every core at once, a run of lines each (below a few megabytes
         // the threads would cost more than they save).
         if (parts <= 0) {

@@ -30,7 +30,7 @@ public:
 private:
     static bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
     void advance() {
-        if (m_text[m_pos++] == '\n') {
+        if (ends_line(m_text, m_pos++)) {
             ++m_line;
             m_column = 1;
         } else {

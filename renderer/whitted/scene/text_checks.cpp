@@ -183,7 +183,7 @@ void check_text_is_readable(std::string_view text, const std::string& path, cons
                 (c == 0xF4 && second > 0x8F))
                 throw InputError({path, line, column}, "the file is not valid UTF-8 text");
         }
-        if (c == '\n')
+        if (ends_line(text, i))
             line += 1, column = 1;
         else
             column += 1;

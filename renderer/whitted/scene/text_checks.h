@@ -10,6 +10,14 @@
 
 namespace whitted {
 
+/// True when the byte at `i` ends a line: a LF, or a CR that no LF follows. Every text format
+/// (YAML, NFF, OBJ, MTL, course XML, .msh) counts lines this way, as YAML 1.2 does (a line break
+/// is CR, LF or CRLF), so that a file saved with CR-only line ends (classic Mac OS) gets the same
+/// LINE:COL in a message as the same file with LF or CRLF ends.
+inline bool ends_line(std::string_view text, size_t i) {
+    return text[i] == '\n' || (text[i] == '\r' && (i + 1 == text.size() || text[i + 1] != '\n'));
+}
+
 /// Reads a whole file, refusing files larger than `max_bytes`, directories, devices, FIFOs and
 /// other files that are not regular, and unreadable paths, with an InputError naming the file
 /// (`what` says what the file was meant to be).

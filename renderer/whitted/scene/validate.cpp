@@ -18,6 +18,7 @@
 #include <optional>
 #include <string_view>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace whitted {
 namespace {
@@ -162,6 +163,12 @@ private:
     /// instances share triangles through Embree's instancing; analytic shapes and planes are not
     /// instanced (and instances inside prototypes are not nested).
     void add_prototypes(const std::vector<PrototypeDescription>& prototypes) {
+        // The prototypes some instance places without a material, found once: a look-up per
+        // prototype, not a pass over every instance (80,000 prototypes of one instance each took
+        // 29 s that way).
+        std::unordered_set<std::string_view> shown_with_defaults;
+        for (const PendingInstance& pending : m_pending_instances)
+            if (pending.material == Instance::no_material) shown_with_defaults.insert(pending.prototype.value);
         for (const PrototypeDescription& d : prototypes) {
             m_prototype_index[d.name] = static_cast<uint32_t>(m_scene.prototypes.size());
             m_prototype_names.push_back(d.name);
@@ -170,10 +177,7 @@ private:
             m_prototype = &prototype;
             // The defaults its OBJ files give (and warn of) show only through an instance
             // without a material of its own.
-            m_prototype_shows_defaults = false;
-            for (const PendingInstance& pending : m_pending_instances)
-                if (pending.prototype.value == d.name && pending.material == Instance::no_material)
-                    m_prototype_shows_defaults = true;
+            m_prototype_shows_defaults = shown_with_defaults.count(d.name) > 0;
             add_object(d.object, Transform());
             m_prototype = nullptr;
             if (prototype.meshes.empty())

@@ -265,7 +265,7 @@ struct LibyamlEvent {
 std::pair<uint32_t, uint32_t> position_of(std::string_view text, size_t offset) {
     uint32_t line = 1, column = 1;
     for (size_t i = 0; i < offset && i < text.size(); ++i) {
-        if (text[i] == '\n')
+        if (ends_line(text, i))
             ++line, column = 1;
         else if ((static_cast<unsigned char>(text[i]) & 0xC0) != 0x80)
             ++column;
@@ -276,11 +276,9 @@ std::pair<uint32_t, uint32_t> position_of(std::string_view text, size_t offset) 
 /// What usually causes a syntax error that libyaml describes tersely.
 std::string syntax_hint(std::string_view text, size_t line) {
     size_t begin = 0;
-    for (size_t l = 1; l < line && begin != std::string_view::npos; ++l) {
-        begin = text.find('\n', begin);
-        if (begin != std::string_view::npos) ++begin;
-    }
-    for (size_t i = begin; i != std::string_view::npos && i < text.size() && (text[i] == ' ' || text[i] == '\t'); ++i)
+    for (size_t l = 1; l < line && begin < text.size(); ++begin)
+        if (ends_line(text, begin)) ++l;
+    for (size_t i = begin; i < text.size() && (text[i] == ' ' || text[i] == '\t'); ++i)
         if (text[i] == '\t') return " (a tab in the indentation: YAML indents with spaces only)";
     return "";
 }
@@ -421,7 +419,9 @@ private:
         while (peek() == ' ') ++m_p;
     }
     void skip_comment() {
-        while (!at_end() && m_text[m_p] != '\n') ++m_p;
+        // A CR ends a comment too (a lone CR is a line break); the scanner then gives up on it
+        // and libyaml reads the file.
+        while (!at_end() && m_text[m_p] != '\n' && m_text[m_p] != '\r') ++m_p;
     }
     /// After a value: spaces, an optional comment, the end of the line.
     void end_of_line() {
