@@ -7,6 +7,9 @@
       image SCENE.xml.soln.png: at least 99.9 % of pixels within 1/255 on every channel. Skipped
       (exit 77) when CORPUS_DIR is absent. Also checks that the scene converted to Whitted's YAML
       renders to the same floats.
+  course_test.py course_image WHITTED DIR SCENE WORK      the same comparison for our own scenes
+      DIR/SCENE.xml against DIR/SCENE.xml.course.png, the image the course's ray tracer made of
+      them (tests/course/glazed/README.md says how). Never skipped.
   course_test.py closed WHITTED SCENES_DIR SCENE WORK      render one of tests/course/scenes and
       compare every pixel with the closed form computed here.
   course_test.py same WHITTED SCENES_DIR SCENE WORK        render X.xml and (convert X.xml ->
@@ -87,11 +90,23 @@ def corpus(whitted, corpus_dir, scene, work):
     if not os.path.isdir(corpus_dir):
         print(f"SKIPPED: the course corpus {corpus_dir} is not present")
         return SKIP
+    xml = os.path.join(corpus_dir, scene + ".xml")
+    return compare_with_course(whitted, xml, xml + ".soln.png", scene, work)
+
+
+def course_image(whitted, directory, scene, work):
+    xml = os.path.join(directory, scene + ".xml")
+    return compare_with_course(whitted, xml, xml + ".course.png", scene, work)
+
+
+def compare_with_course(whitted, xml, course_png, scene, work):
+    """Whitted's render of xml, encoded as the course encodes, against the course's 8-bit image:
+    at least 99.9 % of pixels within 1/255 on every channel; and the scene converted to YAML
+    renders the same floats."""
     from PIL import Image  # python3-pil
 
-    xml = os.path.join(corpus_dir, scene + ".xml")
     width, height, rows = render_floats(whitted, xml, work, scene)
-    reference = Image.open(xml + ".soln.png").convert("RGB")
+    reference = Image.open(course_png).convert("RGB")
     if reference.size != (width, height):
         sys.exit(f"FAIL {scene}: Whitted's image is {width}x{height}, the course's {reference.size}")
     ref = reference.load()
@@ -232,7 +247,8 @@ def main():
     mode, whitted, directory, scene, work = sys.argv[1:6]
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
-    modes = {"corpus": corpus, "closed": closed, "same": same, "pov_refuses": pov_refuses}
+    modes = {"corpus": corpus, "course_image": course_image, "closed": closed, "same": same,
+             "pov_refuses": pov_refuses}
     return modes[mode](whitted, directory, scene, work)
 
 
