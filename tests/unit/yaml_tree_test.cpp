@@ -337,17 +337,20 @@ TEST(MappedTextFile, AnErrorFromTheZerosOfACutFileBecomesTheChange) {
 TEST(MappedTextFileDeathTest, AnotherSigbusIsStillFatal) {
     const test::ScratchDirectory dir;
     const std::string path = dir.write("whole.yaml", "a: 1\n");
+#if defined(__SANITIZE_ADDRESS__)
+    // AddressSanitizer handles SIGBUS itself: it reports the signal and exits with status 1.
+    const auto ends_the_process = ::testing::ExitedWithCode(1);
+    const char* const message = "SEGV|BUS|DEADLYSIGNAL";
+#else
+    const auto ends_the_process = ::testing::KilledBySignal(SIGBUS);
+    const char* const message = "";
+#endif
     EXPECT_EXIT(
         {
             const MappedTextFile file(path, 1 << 20, "scene file");
             ::raise(SIGBUS);
         },
-#if defined(__SANITIZE_ADDRESS__)
-        // AddressSanitizer handles SIGBUS itself: it reports the signal and exits with status 1.
-        ::testing::ExitedWithCode(1), "SEGV|BUS|DEADLYSIGNAL");
-#else
-        ::testing::KilledBySignal(SIGBUS), "");
-#endif
+        ends_the_process, message);
 }
 
 TEST(YamlTree, TheFastScannerSaysWhereItIsAsItGoes) {
