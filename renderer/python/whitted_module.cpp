@@ -359,7 +359,7 @@ PYBIND11_MODULE(whitted, m) {
         .def(
             "background",
             [](api::SceneBuilder& b, std::array<double, 3> c) -> api::SceneBuilder& { return b.background(vec(c)); },
-            py::return_value_policy::reference_internal)
+            py::arg("color"), py::return_value_policy::reference_internal)
         .def(
             "camera",
             [](api::SceneBuilder& b, std::array<double, 3> eye, std::array<double, 3> look_at, std::array<double, 3> up,
@@ -369,10 +369,10 @@ PYBIND11_MODULE(whitted, m) {
         .def(
             "ambient",
             [](api::SceneBuilder& b, std::array<double, 3> c) -> api::SceneBuilder& { return b.ambient(vec(c)); },
-            py::return_value_policy::reference_internal)
+            py::arg("intensity"), py::return_value_policy::reference_internal)
         .def(
             "max_depth", [](api::SceneBuilder& b, int d) -> api::SceneBuilder& { return b.max_depth(d); },
-            py::return_value_policy::reference_internal)
+            py::arg("depth"), py::return_value_policy::reference_internal)
         .def(
             "point_light",
             [](api::SceneBuilder& b, std::array<double, 3> p, std::array<double, 3> i) -> api::SceneBuilder& {
