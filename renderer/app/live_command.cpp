@@ -78,6 +78,15 @@ json to_json(const Vec3& v) {
     return json::array({v.x, v.y, v.z});
 }
 
+/// A member of the request that names a choice: its text, the default when it is absent, and an
+/// empty string (which no choice is) when it is not a string.
+std::string string_member(const json& body, const char* key, const char* fallback) {
+    const auto member = body.find(key);
+    if (member == body.end()) return fallback;
+    const auto* text = member->get_ptr<const json::string_t*>();
+    return text ? *text : std::string();
+}
+
 double finite_number(const json& value, const std::string& what) {
     if (!value.is_number()) throw BadRequest(what + ": expected a number, got " + value.dump());
     const double number = value.get<double>();
@@ -392,7 +401,8 @@ int run_live(const LiveArguments& args) {
         } catch (const std::exception& e) {
             return send_error(response, 400, std::string("the request is not JSON: ") + e.what());
         }
-        const std::string level = body.value("level", "full"), format = body.value("format", "png");
+        if (!body.is_object()) return send_error(response, 400, "the request must be a JSON object");
+        const std::string level = string_member(body, "level", "full"), format = string_member(body, "format", "png");
         if ((level != "full" && level != "coarse") || (format != "png" && format != "exr"))
             return send_error(response, 400, "level must be full or coarse, format png or exr");
         const LiveState::Snapshot snapshot = state.snapshot();
