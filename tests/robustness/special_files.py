@@ -91,6 +91,44 @@ def main():
                 if not ok:
                     failures.append(f"{command[0]}, OCIO config a FIFO by {how}: exit {r.returncode}, {r.stderr!r}")
 
+        # A config whose FileTransform reads a FIFO (found on its search path) or a device: refused
+        # before OpenColorIO builds a transform from it (it would wait, or read without end).
+        os.makedirs(os.path.join(d, "luts"), exist_ok=True)
+        os.mkfifo(os.path.join(d, "luts", "fifo.spi1d"))
+        for lut, named_as in [("fifo.spi1d", "fifo.spi1d"), ("/dev/zero", "/dev/zero")]:
+            config = write(f"lut-{os.path.basename(lut)}.ocio", f"""ocio_profile_version: 2
+search_path: luts
+roles:
+  default: linear
+  scene_linear: linear
+file_rules:
+  - !<Rule> {{name: Default, colorspace: default}}
+displays:
+  sRGB:
+    - !<View> {{name: Lut, colorspace: lut}}
+colorspaces:
+  - !<ColorSpace>
+    name: linear
+  - !<ColorSpace>
+    name: lut
+    from_reference: !<GroupTransform>
+      children:
+        - !<FileTransform> {{src: {lut}, interpolation: linear}}
+""")
+            for command in (["render", ocio_scene, "-o", os.path.join(d, "lut.png"), "--ocio-config", config],
+                            ["colour", "--list", "--ocio-config", config]):
+                try:
+                    r = subprocess.run([whitted, *command], stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                                       timeout=TIMEOUT, cwd=d)
+                except subprocess.TimeoutExpired:
+                    failures.append(f"{command[0]}, a FileTransform from {lut}: still running after {TIMEOUT} s")
+                    continue
+                ok = r.returncode == 2 and "not a regular file" in r.stderr and named_as in r.stderr
+                print(f"{'ok' if ok else 'FAIL'}: {command[0]}, a FileTransform from {lut}: exit {r.returncode}: "
+                      f"{r.stderr.strip()}")
+                if not ok:
+                    failures.append(f"{command[0]}, a FileTransform from {lut}: exit {r.returncode}, {r.stderr!r}")
+
         for what, scene, named in cases:
             for command in ("render", "convert", "explain"):
                 output = os.path.join(d, "out." + ("pov" if command == "convert" else "png"))

@@ -139,6 +139,61 @@ std::vector<std::string> views_of(const OCIO::ConstConfigRcPtr& config, const st
     return names;
 }
 
+/// The file a FileTransform's `src` names, found as OpenColorIO finds it: an absolute path as it
+/// is, else the first search path (context variables expanded, relative to the config's folder)
+/// that holds it; empty when none does (OpenColorIO then reports it missing itself).
+std::filesystem::path file_transform_source(const OCIO::ConstConfigRcPtr& config, const char* src) {
+    const OCIO::ConstContextRcPtr context = config->getCurrentContext();
+    const std::filesystem::path name = context->resolveStringVar(src);
+    std::error_code error;
+    if (name.is_absolute()) return name;
+    for (int i = 0; i < config->getNumSearchPaths(); ++i) {
+        std::filesystem::path folder = context->resolveStringVar(config->getSearchPath(i));
+        if (folder.is_relative()) folder = std::filesystem::path(config->getWorkingDir()) / folder;
+        if (std::filesystem::exists(folder / name, error)) return folder / name;
+    }
+    return {};
+}
+
+/// Every FileTransform of the config, in its colour spaces, looks and view transforms (inside
+/// groups too), must name a regular file: OpenColorIO would wait forever on a FIFO and read a
+/// device such as /dev/zero without end when the transform is built.
+void refuse_file_transforms_from_special_files(const OCIO::ConstConfigRcPtr& config) {
+    std::function<void(const OCIO::ConstTransformRcPtr&)> walk = [&](const OCIO::ConstTransformRcPtr& transform) {
+        if (!transform) return;
+        if (const auto group = OCIO::DynamicPtrCast<const OCIO::GroupTransform>(transform)) {
+            for (int i = 0; i < group->getNumTransforms(); ++i) walk(group->getTransform(i));
+        } else if (const auto file = OCIO::DynamicPtrCast<const OCIO::FileTransform>(transform)) {
+            const std::filesystem::path path = file_transform_source(config, file->getSrc());
+            std::error_code error;
+            const auto status = std::filesystem::status(path, error);
+            if (!path.empty() && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+                throw std::runtime_error("its FileTransform source '" + std::string(file->getSrc()) + "' ('" +
+                                         path.string() +
+                                         "') is not a regular file (a FIFO, socket, device or directory)");
+        }
+    };
+    for (int i = 0; i < config->getNumColorSpaces(OCIO::SEARCH_REFERENCE_SPACE_ALL, OCIO::COLORSPACE_ALL); ++i) {
+        const OCIO::ConstColorSpaceRcPtr space = config->getColorSpace(
+            config->getColorSpaceNameByIndex(OCIO::SEARCH_REFERENCE_SPACE_ALL, OCIO::COLORSPACE_ALL, i));
+        if (!space) continue;
+        walk(space->getTransform(OCIO::COLORSPACE_DIR_TO_REFERENCE));
+        walk(space->getTransform(OCIO::COLORSPACE_DIR_FROM_REFERENCE));
+    }
+    for (int i = 0; i < config->getNumLooks(); ++i) {
+        const OCIO::ConstLookRcPtr look = config->getLook(config->getLookNameByIndex(i));
+        if (!look) continue;
+        walk(look->getTransform());
+        walk(look->getInverseTransform());
+    }
+    for (int i = 0; i < config->getNumViewTransforms(); ++i) {
+        const OCIO::ConstViewTransformRcPtr view = config->getViewTransform(config->getViewTransformNameByIndex(i));
+        if (!view) continue;
+        walk(view->getTransform(OCIO::VIEWTRANSFORM_DIR_TO_REFERENCE));
+        walk(view->getTransform(OCIO::VIEWTRANSFORM_DIR_FROM_REFERENCE));
+    }
+}
+
 /// The config `config_path` names, else $OCIO's, else the built-in one; `source` says which.
 OCIO::ConstConfigRcPtr load_config(const std::string& config_path, std::string& source) {
     const char* env = std::getenv("OCIO");
@@ -157,12 +212,16 @@ OCIO::ConstConfigRcPtr load_config(const std::string& config_path, std::string& 
         if (!config_path.empty()) {
             check_file(config_path);
             source = config_path;
-            return OCIO::Config::CreateFromFile(config_path.c_str());
+            const OCIO::ConstConfigRcPtr config = OCIO::Config::CreateFromFile(config_path.c_str());
+            refuse_file_transforms_from_special_files(config);
+            return config;
         }
         if (env && *env) {
             check_file(env);
             source = std::string("$OCIO=") + env;
-            return OCIO::Config::CreateFromFile(env);
+            const OCIO::ConstConfigRcPtr config = OCIO::Config::CreateFromFile(env);
+            refuse_file_transforms_from_special_files(config);
+            return config;
         }
     } catch (const std::exception& e) {
         throw std::invalid_argument(
