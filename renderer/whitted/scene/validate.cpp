@@ -396,8 +396,10 @@ private:
     static std::string join_names(const std::vector<std::string>& names) {
         constexpr size_t most_listed = 20;
         std::string out;
-        for (size_t i = 0; i < names.size() && i < most_listed; ++i)
-            out += (out.empty() ? "" : ", ") + printable(names[i], 40);
+        for (size_t i = 0; i < names.size() && i < most_listed; ++i) {
+            if (i > 0) out += ", ";
+            out += printable(names[i], 40);
+        }
         if (names.size() > most_listed) out += ", ... (" + std::to_string(names.size()) + " in all)";
         return out;
     }
