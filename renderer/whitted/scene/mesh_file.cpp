@@ -110,6 +110,7 @@ bool is_plain_text(std::string_view text) {
 /// the same, so every column is what it was. `storage` holds the copy, made only when the text
 /// has a lone CR (CRLF files are read as they are: a CR is blank before the LF).
 std::string_view with_lone_carriage_returns_as_line_feeds(std::string_view text, std::string& storage) {
+    if (text.empty()) return text;  // an empty file's view may hold no pointer, which memchr must not get
     const char* const end = text.data() + text.size();
     const char* p = text.data();
     for (; (p = static_cast<const char*>(std::memchr(p, '\r', size_t(end - p)))); ++p)
