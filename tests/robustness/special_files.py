@@ -71,6 +71,19 @@ def main():
         os.symlink("/dev/zero", os.path.join(d, "zero-link.yaml"))
         write("with_mtl.obj", "mtllib fifo-table.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n")
 
+        def expect_refused(command, what, named, env=None):
+            """The command exits 2, in bounded time, saying `named` is not a regular file."""
+            try:
+                r = subprocess.run([whitted, *command], stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                                   timeout=TIMEOUT, cwd=d, env={**os.environ, **(env or {})})
+            except subprocess.TimeoutExpired:
+                failures.append(f"{command[0]}, {what}: still running after {TIMEOUT} s")
+                return
+            ok = r.returncode == 2 and "not a regular file" in r.stderr and named in r.stderr
+            print(f"{'ok' if ok else 'FAIL'}: {command[0]}, {what}: exit {r.returncode}: {r.stderr.strip()}")
+            if not ok:
+                failures.append(f"{command[0]}, {what}: exit {r.returncode}, {r.stderr!r}")
+
         # The OpenColorIO config: a FIFO given with --ocio-config or $OCIO is refused before OCIO
         # opens it (it would wait for a writer forever).
         ocio_scene = write("plain.yaml", SCENE_HEAD + "objects:\n  - { type: sphere, center: [0, 0, 0], radius: 1, "
@@ -79,23 +92,13 @@ def main():
                                ("$OCIO", [], {"OCIO": fifo})]:
             for command in (["render", ocio_scene, "-o", os.path.join(d, "ocio.png"), *args],
                             ["colour", "--list", *args]):
-                try:
-                    r = subprocess.run([whitted, *command], stdin=subprocess.DEVNULL, capture_output=True, text=True,
-                                       timeout=TIMEOUT, cwd=d, env={**os.environ, **env})
-                except subprocess.TimeoutExpired:
-                    failures.append(f"{command[0]}, OCIO config a FIFO by {how}: still running after {TIMEOUT} s")
-                    continue
-                ok = r.returncode == 2 and "not a regular file" in r.stderr and fifo in r.stderr
-                print(f"{'ok' if ok else 'FAIL'}: {command[0]}, OCIO config a FIFO by {how}: exit {r.returncode}: "
-                      f"{r.stderr.strip()}")
-                if not ok:
-                    failures.append(f"{command[0]}, OCIO config a FIFO by {how}: exit {r.returncode}, {r.stderr!r}")
+                expect_refused(command, f"OCIO config a FIFO by {how}", fifo, env)
 
         # A config whose FileTransform reads a FIFO (found on its search path) or a device: refused
         # before OpenColorIO builds a transform from it (it would wait, or read without end).
         os.makedirs(os.path.join(d, "luts"), exist_ok=True)
         os.mkfifo(os.path.join(d, "luts", "fifo.spi1d"))
-        for lut, named_as in [("fifo.spi1d", "fifo.spi1d"), ("/dev/zero", "/dev/zero")]:
+        for lut in ("fifo.spi1d", "/dev/zero"):
             config = write(f"lut-{os.path.basename(lut)}.ocio", f"""ocio_profile_version: 2
 search_path: luts
 roles:
@@ -117,17 +120,7 @@ colorspaces:
 """)
             for command in (["render", ocio_scene, "-o", os.path.join(d, "lut.png"), "--ocio-config", config],
                             ["colour", "--list", "--ocio-config", config]):
-                try:
-                    r = subprocess.run([whitted, *command], stdin=subprocess.DEVNULL, capture_output=True, text=True,
-                                       timeout=TIMEOUT, cwd=d)
-                except subprocess.TimeoutExpired:
-                    failures.append(f"{command[0]}, a FileTransform from {lut}: still running after {TIMEOUT} s")
-                    continue
-                ok = r.returncode == 2 and "not a regular file" in r.stderr and named_as in r.stderr
-                print(f"{'ok' if ok else 'FAIL'}: {command[0]}, a FileTransform from {lut}: exit {r.returncode}: "
-                      f"{r.stderr.strip()}")
-                if not ok:
-                    failures.append(f"{command[0]}, a FileTransform from {lut}: exit {r.returncode}, {r.stderr!r}")
+                expect_refused(command, f"a FileTransform from {lut}", lut)
 
         for what, scene, named in cases:
             for command in ("render", "convert", "explain"):
