@@ -208,20 +208,20 @@ OCIO::ConstConfigRcPtr load_config(const std::string& config_path, std::string& 
         if (!std::filesystem::is_regular_file(status))
             throw std::runtime_error("it is not a regular file (a FIFO, socket or device)");
     };
+    const auto from_file = [&](const std::string& path) {
+        check_file(path);
+        const OCIO::ConstConfigRcPtr config = OCIO::Config::CreateFromFile(path.c_str());
+        refuse_file_transforms_from_special_files(config);
+        return config;
+    };
     try {
         if (!config_path.empty()) {
-            check_file(config_path);
             source = config_path;
-            const OCIO::ConstConfigRcPtr config = OCIO::Config::CreateFromFile(config_path.c_str());
-            refuse_file_transforms_from_special_files(config);
-            return config;
+            return from_file(config_path);
         }
         if (env && *env) {
-            check_file(env);
             source = std::string("$OCIO=") + env;
-            const OCIO::ConstConfigRcPtr config = OCIO::Config::CreateFromFile(env);
-            refuse_file_transforms_from_special_files(config);
-            return config;
+            return from_file(env);
         }
     } catch (const std::exception& e) {
         throw std::invalid_argument(
