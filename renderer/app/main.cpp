@@ -666,11 +666,10 @@ bool embree_isa_usable() {
 
 int main(int argc, char** argv) {
     // Transparent huge pages off for this process. Embree asks for them (madvise) for all its
-    // BVH memory. On the virtual machines Whitted is measured on, the host takes back the
-    // guest's free memory in 2 MiB blocks (virtio-balloon free page reporting), and a huge
-    // page is exactly such a block: its first touch is then 512 faults on the host. The
-    // 1M-triangle build took 0.37-0.40 s in three runs of five against 0.11 s with ordinary
-    // pages, and no scene rendered faster with them (docs/performance.md, "Huge pages off again").
+    // BVH memory. Where a virtual machine's host takes back the guest's free memory in 2 MiB
+    // blocks (virtio-balloon free page reporting), a huge page is exactly such a block and its
+    // first touch costs the host 512 faults: BVH builds ran several times slower, and no scene
+    // rendered faster with them (docs/performance.md, "Design choices and what they cost").
     prctl(PR_SET_THP_DISABLE, 1, 0, 0, 0);
     // Past a file size limit (ulimit -f) a write fails with EFBIG, which every command reports and
     // cleans up after, instead of SIGXFSZ killing the process with a temporary file left.
