@@ -22,61 +22,17 @@ The linear EXR is read back here (32-bit floats, exact)."""
 import math
 import os
 import shutil
-import struct
 import subprocess
 import sys
 
-SKIP = 77
-
-
-def run(command):
-    result = subprocess.run(command, capture_output=True, text=True, timeout=600)
-    if result.returncode != 0:
-        sys.exit(f"FAIL: {' '.join(command)} exited {result.returncode}\n{result.stderr[-3000:]}")
-    return result
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import SKIP, read_exr, run  # noqa: E402  (tests/harness.py)
 
 
 def render_floats(whitted, scene, work, name):
     exr = os.path.join(work, name + ".exr")
     run([whitted, "render", scene, "-o", exr, "-q"])  # 32-bit floats, no compression (the defaults)
     return read_exr(exr)
-
-
-def read_exr(path):
-    """(width, height, rows from the top, each a list of (r, g, b)) from an uncompressed scanline
-    OpenEXR file of 32-bit float R, G, B channels, the kind `whitted render -o x.exr` writes.
-    Read here, byte by byte, so the floats are exactly those Whitted wrote."""
-    with open(path, "rb") as f:
-        data = f.read()
-    assert data[:4] == b"\x76\x2f\x31\x01", f"{path}: not an OpenEXR file"
-    pos, attributes = 8, {}
-    while data[pos] != 0:
-        name_end = data.index(b"\0", pos)
-        type_end = data.index(b"\0", name_end + 1)
-        name, kind = data[pos:name_end].decode(), data[name_end + 1:type_end].decode()
-        size = struct.unpack_from("<i", data, type_end + 1)[0]
-        attributes[name] = (kind, data[type_end + 5:type_end + 5 + size])
-        pos = type_end + 5 + size
-    pos += 1
-    assert attributes["compression"][1][0] == 0, f"{path}: compressed; the test reads uncompressed files"
-    x0, y0, x1, y1 = struct.unpack("<4i", attributes["dataWindow"][1])
-    width, height = x1 - x0 + 1, y1 - y0 + 1
-    channels, chlist = [], attributes["channels"][1]
-    at = 0
-    while chlist[at] != 0:
-        end = chlist.index(b"\0", at)
-        channels.append((chlist[at:end].decode(), struct.unpack_from("<i", chlist, end + 1)[0]))
-        at = end + 1 + 16
-    assert [c for c, _ in channels] == ["B", "G", "R"] and all(t == 2 for _, t in channels), channels
-    offsets = struct.unpack_from(f"<{height}Q", data, pos)
-    rows = []
-    for y in range(height):
-        block = offsets[y] + 8  # the scanline's y and byte count come first
-        b = struct.unpack_from(f"<{width}f", data, block)
-        g = struct.unpack_from(f"<{width}f", data, block + 4 * width)
-        r = struct.unpack_from(f"<{width}f", data, block + 8 * width)
-        rows.append([(r[x], g[x], b[x]) for x in range(width)])
-    return width, height, rows
 
 
 def course_encode(c):

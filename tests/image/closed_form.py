@@ -24,9 +24,11 @@ sign, sample position or averaging fails. Sizes are odd (partly filled packets a
 
 import math
 import os
-import struct
 import subprocess
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import read_exr  # noqa: E402  (tests/harness.py)
 
 TOLERANCE = 1e-6
 
@@ -91,29 +93,6 @@ def scene_yaml(case):
         f"{{ka: {vec(case['ka'])}, kd: {vec(case['kd'])}, ks: {vec(case['ks'])}, p: {case['p']}}}}}",
         "",
     ])
-
-
-def read_exr(path):
-    """Width, height and rows of floats of an uncompressed 3-channel float EXR (the layout
-    tests/isa/isa_identical.py reads: header, offset table, then one (y, size, B G R) chunk per
-    row; the channels are stored in alphabetical order)."""
-    data = open(path, "rb").read()
-    key = b"dataWindow\0box2i\0"
-    at = data.find(key)
-    if at < 0:
-        raise ValueError(f"{path}: no dataWindow attribute")
-    xmin, ymin, xmax, ymax = struct.unpack_from("<4i", data, at + len(key) + 4)
-    width, height = xmax - xmin + 1, ymax - ymin + 1
-    row = 3 * 4 * width
-    start = len(data) - height * (8 + row)
-    pixels = []
-    for k in range(height):
-        y, size = struct.unpack_from("<2i", data, start + k * (8 + row))
-        if y != ymin + k or size != row:
-            raise ValueError(f"{path}: not an uncompressed float RGB EXR (row {k})")
-        b, g, r = (struct.unpack_from(f"<{width}f", data, start + k * (8 + row) + 8 + c * 4 * width) for c in range(3))
-        pixels.append([(r[i], g[i], b[i]) for i in range(width)])
-    return width, height, pixels
 
 
 CASES = {

@@ -26,21 +26,15 @@ import math
 import os
 import random
 import re
-import struct
-import subprocess
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import run  # noqa: E402  (tests/harness.py)
 
 import numpy as np
 import OpenImageIO as oiio
 
 COLOUR_TERMS = ["ambient", "diffuse", "specular", "mirror", "transmission", "background"]
-
-
-def run(args, expect=0):
-    result = subprocess.run(args, capture_output=True, text=True)
-    if result.returncode != expect:
-        sys.exit(f"FAIL: {' '.join(args)} exited {result.returncode}, expected {expect}\n{result.stderr}")
-    return result
 
 
 def read_exr(path):

@@ -18,17 +18,8 @@ import shutil
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "course"))
-from course_test import read_exr  # noqa: E402  (the uncompressed-EXR reader, byte by byte)
-
-SKIP = 77
-
-
-def run(command, timeout=900):
-    result = subprocess.run(command, capture_output=True, text=True, timeout=timeout)
-    if result.returncode != 0:
-        sys.exit(f"FAIL: {' '.join(command)} exited {result.returncode}\n{result.stderr[-3000:]}")
-    return result
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import SKIP, read_exr, run  # noqa: E402  (tests/harness.py)
 
 
 def fresh(work):
