@@ -3,6 +3,7 @@
 // turned into an Error value here, with the location an InputError carries.
 
 #include "api/api_internal.h"
+#include "api/errors.h"
 #include "converters/pov_writer.h"
 #include "reference/check.h"
 #include "whitted/core/plugin.h"
@@ -30,41 +31,26 @@ double seconds_since(clock::time_point start) {
     return std::chrono::duration<double>(clock::now() - start).count();
 }
 
-Error input_error(const InputError& e) {
-    Error error;
-    error.message = e.message();
-    error.file = e.where().file.str();
-    error.line = e.where().line;
-    error.column = e.where().column;
-    return error;
-}
-
-Error plain_error(std::string message, Error::Kind kind, std::string file = {}) {
+Error plain_error(std::string message, Error::Kind kind) {
     Error error;
     error.message = std::move(message);
     error.kind = kind;
-    error.file = std::move(file);
     return error;
 }
 
-/// Runs `work`, turning what it throws into an Error: InputError and std::invalid_argument are the
-/// caller's input (bad_input), anything else a failure. `what` finishes "out of memory while ...".
+/// Runs `work`, turning what it throws into an Error (api/errors.h); `what` finishes "out of
+/// memory while ...".
 template <class T, class Work>
 Expected<T> guarded(const std::string& what, Work&& work) {
     try {
         return work();
-    } catch (const InputError& e) {
-        return input_error(e);
-    } catch (const std::invalid_argument& e) {
-        return plain_error(e.what(), Error::Kind::bad_input);
-    } catch (const std::bad_alloc&) {
-        return plain_error("out of memory while " + what, Error::Kind::failure);
-    } catch (const std::exception& e) {
-        return plain_error(e.what(), Error::Kind::failure);
+    } catch (...) {
+        return current_error({what});
     }
 }
 
-/// `read` fills the description and the validated scene of a new Scene::Impl.
+/// `read` fills the description and the validated scene of a new Scene::Impl. An error without
+/// a place names `label`; one reading a file (a filesystem error) is the caller's input.
 Expected<Scene> load(const std::string& label, const std::function<void(Scene::Impl&)>& read) {
     try {
         auto impl = std::make_unique<Scene::Impl>();
@@ -72,18 +58,8 @@ Expected<Scene> load(const std::string& label, const std::function<void(Scene::I
         read(*impl);
         impl->read_seconds = seconds_since(start);
         return Scene(std::move(impl));
-    } catch (const InputError& e) {
-        return input_error(e);
-    } catch (const std::invalid_argument& e) {
-        return plain_error(e.what(), Error::Kind::bad_input);
-    } catch (const std::bad_alloc&) {
-        // A scene or mesh too large for this machine's memory: an error, never an abort.
-        return plain_error("out of memory while reading the scene", Error::Kind::failure, label);
-    } catch (const FileChangedWhileRead& e) {
-        // Not the input's fault: another program changed it under the reader (exit 1).
-        return plain_error(e.what(), Error::Kind::failure, label);
-    } catch (const std::exception& e) {  // e.g. a filesystem error while reading
-        return plain_error(e.what(), Error::Kind::bad_input, label);
+    } catch (...) {
+        return current_error({"reading the scene", label, Error::Kind::bad_input});
     }
 }
 
@@ -94,13 +70,7 @@ LayerSet layers_for(const Scene& scene, const RenderOptions& options) {
     if (names.empty())
         for (const auto& layer : description.layers) names.push_back(layer.value);
     const LayerSet layers = parse_layers(names);
-    // The colour layers split each hit's terms at weight 1; a glazed (fresnel_ior) material
-    // scales them by 1 − F, which the layers do not yet follow, so they would not add up.
-    if (!layers.empty())
-        for (const whitted::Material& material : scene.impl().scene.materials)
-            if (material.fresnel_r0 >= 0)
-                throw std::invalid_argument(
-                    "render layers are not available for scenes with a fresnel_ior (glazed) material yet");
+    refuse_unsupported_layers(scene.impl().scene, layers);
     return layers;
 }
 
@@ -183,6 +153,16 @@ whitted::Vec3 vec(const Vec3& v) {
 
 const char* version() {
     return WHITTED_VERSION_STRING;
+}
+
+void refuse_unsupported_layers(const whitted::Scene& scene, const LayerSet& layers) {
+    // The colour layers split each hit's terms at weight 1; a glazed (fresnel_ior) material
+    // scales them by 1 − F, which the layers do not yet follow, so they would not add up.
+    if (!layers.empty())
+        for (const whitted::Material& material : scene.materials)
+            if (material.fresnel_r0 >= 0)
+                throw std::invalid_argument(
+                    "render layers are not available for scenes with a fresnel_ior (glazed) material yet");
 }
 
 const Accelerator& Scene::Impl::accelerator(int threads) const {
@@ -424,13 +404,12 @@ SceneBuilder& SceneBuilder::triangle(Vec3 a, Vec3 b, Vec3 c, const Material& mat
 
 Expected<Scene> SceneBuilder::build() const {
     const Impl& impl = *m_impl;
-    const FileName file("<SceneBuilder>");
-    if (!impl.image_call)
-        return input_error(InputError({file, 0, 0}, "no image(width, height) given: the scene needs its size"));
-    if (!impl.camera_call)
-        return input_error(InputError({file, 0, 0}, "no camera(eye, look_at) given: the scene needs a camera"));
-    if (impl.first_error) return input_error(*impl.first_error);
     return load("<SceneBuilder>", [&](Scene::Impl& built) {
+        const FileName file("<SceneBuilder>");
+        if (!impl.image_call) throw InputError({file, 0, 0}, "no image(width, height) given: the scene needs its size");
+        if (!impl.camera_call)
+            throw InputError({file, 0, 0}, "no camera(eye, look_at) given: the scene needs a camera");
+        if (impl.first_error) throw *impl.first_error;
         built.description = impl.description;
         built.scene = validate_scene(built.description);
     });

@@ -6,6 +6,7 @@
 // `whitted` program (for --stats) include this; the public headers never do.
 
 #include "whitted/render/accelerator.h"
+#include "whitted/render/layers.h"
 #include "whitted/render/work_exchange.h"
 #include "whitted/scene/description.h"
 #include "whitted/scene/scene.h"
@@ -36,6 +37,10 @@ private:
     mutable std::unique_ptr<SceneDescription> m_reread;
     mutable std::unique_ptr<Accelerator> m_accelerator;
 };
+
+/// Throws std::invalid_argument when the scene cannot have these render layers (a glazed
+/// material); the one statement of that rule, for api::render and `whitted render`'s usage check.
+void refuse_unsupported_layers(const whitted::Scene& scene, const LayerSet& layers);
 
 /// api::render with the tiles shared among MPI ranks through `exchange` (null: one process), for
 /// `whitted render` under mpirun (docs/distributed.md); not in the public API yet. On a rank other

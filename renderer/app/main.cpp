@@ -4,6 +4,7 @@
 // (0 ok, 1 failure while rendering or checking, 2 bad input or usage, 130/143 interrupted).
 
 #include "api/api_internal.h"
+#include "api/errors.h"
 #include "converters/pov_writer.h"
 #include "converters/yaml_writer.h"
 #include "explain_command.h"
@@ -51,7 +52,7 @@ namespace {
 
 using namespace whitted;
 
-constexpr int exit_ok = 0, exit_failure = 1, exit_bad_input = 2;
+using api::exit_bad_input, api::exit_failure, api::exit_ok;
 
 std::atomic<bool> g_cancel{false};
 std::atomic<int> g_signal{0};
@@ -297,28 +298,17 @@ private:
     std::chrono::steady_clock::time_point m_start = std::chrono::steady_clock::now(), m_last = m_start;
 };
 
-/// Runs `work`; a mistake in the input it throws is printed as `whitted` prints it, and the exit
-/// status returned (−1: none). `scene` names the file for errors that do not carry a place (a
-/// filesystem error, say).
+/// Runs `work`, a check before the render; what it throws is printed as `whitted` prints it, and
+/// the exit status returned (−1: none). `scene` names the file for errors that do not carry a
+/// place (a filesystem error, say).
 template <class Work>
 int exit_on_input_error(const std::string& scene, Work&& work) {
     try {
         work();
         return -1;
-    } catch (const InputError& e) {
-        print_error(e.what());
-    } catch (const std::invalid_argument& e) {
-        print_error(e.what());
-    } catch (const std::exception& e) {
-        print_error(scene + ": " + e.what());
+    } catch (...) {
+        return api::report(api::current_error({"checking " + scene, scene, api::Error::Kind::bad_input}));
     }
-    return exit_bad_input;
-}
-
-/// The API's error, printed as `whitted` always has; its exit status.
-int report(const api::Error& error) {
-    print_error(error.what());
-    return error.kind == api::Error::Kind::bad_input ? exit_bad_input : exit_failure;
 }
 
 /// `whitted render`: a user of the public API (whitted/whitted.h) for loading, rendering and
@@ -329,9 +319,10 @@ int run_render(const RenderArguments& args) {
     if (const std::string evidence = mpi_launch_evidence(); !evidence.empty()) {
         try {
             g_exchange = open_mpi_exchange();
-        } catch (const std::exception& e) {
-            print_error(std::string(e.what()) + " (this process was started as an MPI rank: " + evidence + ")");
-            return exit_failure;
+        } catch (...) {
+            api::Error error = api::current_error({"starting MPI"});
+            error.message += " (this process was started as an MPI rank: " + evidence + ")";
+            return api::report(error);
         }
     }
     install_signal_handlers();
@@ -353,7 +344,7 @@ int run_render(const RenderArguments& args) {
     };
     if (const int status = exit_on_input_error(args.scene, check_usage); status >= 0) return status;
     api::Expected<api::Scene> read = load_scene_argument(args.scene, args.overrides);
-    if (!read) return report(read.error());
+    if (!read) return api::report(read.error());
     loaded.emplace(std::move(read).value());
     const api::Scene::Impl& impl = loaded->impl();
     const SceneDescription& description = impl.description;
@@ -373,13 +364,7 @@ int run_render(const RenderArguments& args) {
         if (crop && (int64_t(crop->x) + crop->width > scene.width || int64_t(crop->y) + crop->height > scene.height))
             throw std::invalid_argument("--crop " + args.crop + " does not lie inside the " +
                                         std::to_string(scene.width) + "x" + std::to_string(scene.height) + " image");
-        // The colour layers split each hit's terms at weight 1; a glazed (fresnel_ior) material
-        // scales them by 1 − F, which the layers do not yet follow, so they would not add up.
-        if (!layers.empty())
-            for (const Material& material : scene.materials)
-                if (material.fresnel_r0 >= 0)
-                    throw std::invalid_argument(
-                        "render layers are not available for scenes with a fresnel_ior (glazed) material yet");
+        api::refuse_unsupported_layers(scene, layers);
     };
     if (const int status = exit_on_input_error(args.scene, check_scene_output); status >= 0) return status;
 
@@ -404,7 +389,7 @@ int run_render(const RenderArguments& args) {
             rendered = api::render_distributed(*loaded, options, g_exchange.get());
         }
         if (progress_bar) std::fputc('\n', stderr);
-        if (!rendered) return report(rendered.error());
+        if (!rendered) return api::report(rendered.error());
         const api::RenderResult& result = rendered.value();
         if (g_exchange && g_exchange->rank() != 0)  // its tiles are with rank 0, which writes the image
             return result.cancelled ? 128 + (g_signal.load() ? g_signal.load() : SIGINT) : exit_ok;
@@ -437,7 +422,7 @@ int run_render(const RenderArguments& args) {
             if (args.partial) {
                 write.metadata.push_back({"whitted:partial", "true: interrupted; unfinished tiles are black"});
                 if (const auto written = api::write_image(result.image, args.output, write); !written)
-                    return report(written.error());
+                    return api::report(written.error());
                 std::fprintf(stderr, "whitted: interrupted; partial image (unfinished tiles black) written to %s\n",
                              args.output.c_str());
             } else {
@@ -447,7 +432,7 @@ int run_render(const RenderArguments& args) {
             return 128 + (signal ? signal : SIGINT);
         }
         if (const auto written = api::write_image(result.image, args.output, write); !written)
-            return report(written.error());
+            return api::report(written.error());
         const double write_seconds = timer.lap();
         // Radiance past the largest float is +inf in the image, as IEEE arithmetic has it: said,
         // because only a scene of enormous colours, intensities or mirror weights gets there.
@@ -486,18 +471,8 @@ int run_render(const RenderArguments& args) {
                 result.stats.reflected_rays / 1e6, result.stats.seconds > 0 ? rays / result.stats.seconds / 1e6 : 0.0,
                 args.output.c_str());
         return exit_ok;
-    } catch (const InputError& e) {  // e.g. a shape beyond the range the accelerator takes
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::invalid_argument& e) {
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::bad_alloc&) {
-        print_error("out of memory while rendering " + args.scene);
-        return exit_failure;
-    } catch (const std::exception& e) {
-        print_error(e.what());
-        return exit_failure;
+    } catch (...) {  // e.g. an InputError: a shape beyond the range the accelerator takes
+        return api::report(api::current_error({"rendering " + args.scene}));
     }
 }
 
@@ -551,15 +526,8 @@ int run_convert(const std::string& scene_path, const std::string& output) {
         const std::string ini = pov::write_pov_files(description, output);
         std::fprintf(stderr, "whitted: wrote %s and %s\n", output.c_str(), ini.c_str());
         return exit_ok;
-    } catch (const InputError& e) {
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::invalid_argument& e) {
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::exception& e) {
-        print_error(e.what());
-        return exit_failure;
+    } catch (...) {
+        return api::report(api::current_error({"converting " + scene_path}));
     }
 }
 
@@ -575,9 +543,8 @@ int run_check_command(const std::string& scene_path, reference::CheckOptions opt
     try {
         const auto run_check = reinterpret_cast<RunCheck>(image_io_plugin_symbol("whitted_run_check"));
         return run_check(scene_path, options, g_signal);
-    } catch (const std::exception& e) {
-        print_error(e.what());
-        return exit_bad_input;
+    } catch (...) {  // the plug-in cannot be loaded
+        return api::report(api::current_error({"checking " + scene_path, "", api::Error::Kind::bad_input}));
     }
 }
 
@@ -587,9 +554,9 @@ int run_compare_command(const std::string& first, const std::string& second, con
     try {
         const auto run_compare = reinterpret_cast<RunCompare>(image_io_plugin_symbol("whitted_run_compare"));
         return run_compare(first, second, rule, clip);
-    } catch (const std::exception& e) {
-        print_error(e.what());
-        return exit_bad_input;
+    } catch (...) {  // the plug-in cannot be loaded
+        return api::report(
+            api::current_error({"comparing " + first + " and " + second, "", api::Error::Kind::bad_input}));
     }
 }
 
@@ -606,12 +573,8 @@ int run_colour(bool list, const std::string& config, const std::string& write_co
         }
         if (list) std::fputs(DisplayTransform::describe_config(config).c_str(), stdout);
         return exit_ok;
-    } catch (const std::invalid_argument& e) {
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::exception& e) {
-        print_error(e.what());
-        return exit_failure;
+    } catch (...) {
+        return api::report(api::current_error({"writing the colour config"}));
     }
 }
 
@@ -656,8 +619,8 @@ bool embree_isa_usable() {
     try {
         require_embree_isa(embree_isa_from_environment());
         return true;
-    } catch (const std::exception& e) {
-        print_error(e.what());
+    } catch (...) {
+        api::report(api::current_error({"checking WHITTED_EMBREE_ISA", "", api::Error::Kind::bad_input}));
         return false;
     }
 }
@@ -939,9 +902,8 @@ int main(int argc, char** argv) {
     }
     try {
         check_options.layers = parse_layers(check_layers);
-    } catch (const std::invalid_argument& e) {
-        print_error(e.what());
-        return exit_bad_input;
+    } catch (...) {
+        return api::report(api::current_error({"reading --layers", "", api::Error::Kind::bad_input}));
     }
     check_options.rule.tolerance = tolerance_codes / 65535.0;
     check_options.rule.max_error = max_error_codes / 65535.0;
