@@ -65,12 +65,16 @@ Expected<Scene> load(const std::string& label, const std::function<void(Scene::I
 
 /// The layers a render computes: the options', else the scene's render.layers.
 LayerSet layers_for(const Scene& scene, const RenderOptions& options) {
-    const SceneDescription& description = scene.impl().description;
     std::vector<std::string> names = options.layers;
-    if (names.empty())
-        for (const auto& layer : description.layers) names.push_back(layer.value);
+    if (names.empty()) names = scene.layers();
     const LayerSet layers = parse_layers(names);
-    refuse_unsupported_layers(scene.impl().scene, layers);
+    // The colour layers split each hit's terms at weight 1; a glazed (fresnel_ior) material
+    // scales them by 1 − F, which the layers do not yet follow, so they would not add up.
+    if (!layers.empty())
+        for (const whitted::Material& material : impl_of(scene).scene.materials)
+            if (material.fresnel_r0 >= 0)
+                throw std::invalid_argument(
+                    "render layers are not available for scenes with a fresnel_ior (glazed) material yet");
     return layers;
 }
 
@@ -90,7 +94,7 @@ std::optional<TileRect> crop_window(const Scene& scene, const RenderOptions& opt
 whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& options, LayerSet layers,
                                       WorkExchange* exchange = nullptr) {
     const std::optional<TileRect> crop = crop_window(scene, options);
-    const Accelerator& accelerator = scene.impl().accelerator(options.threads);
+    const Accelerator& accelerator = impl_of(scene).accelerator(options.threads);
     // The progress callback may cancel too: then one flag of ours for both, set by either (the
     // caller's copied in by a watcher); without a callback the tiles check the caller's own.
     std::atomic<bool> stop{options.cancel && options.cancel->load()};
@@ -116,8 +120,8 @@ whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& o
         };
     whitted::RenderResult result;
     try {
-        result = exchange ? whitted::render_distributed(scene.impl().scene, accelerator, internal, *exchange)
-                          : whitted::render(scene.impl().scene, accelerator, internal);
+        result = exchange ? whitted::render_distributed(impl_of(scene).scene, accelerator, internal, *exchange)
+                          : whitted::render(impl_of(scene).scene, accelerator, internal);
     } catch (...) {
         watching.store(false);
         if (watcher.joinable()) watcher.join();
@@ -153,16 +157,6 @@ whitted::Vec3 vec(const Vec3& v) {
 
 const char* version() {
     return WHITTED_VERSION_STRING;
-}
-
-void refuse_unsupported_layers(const whitted::Scene& scene, const LayerSet& layers) {
-    // The colour layers split each hit's terms at weight 1; a glazed (fresnel_ior) material
-    // scales them by 1 − F, which the layers do not yet follow, so they would not add up.
-    if (!layers.empty())
-        for (const whitted::Material& material : scene.materials)
-            if (material.fresnel_r0 >= 0)
-                throw std::invalid_argument(
-                    "render layers are not available for scenes with a fresnel_ior (glazed) material yet");
 }
 
 const Accelerator& Scene::Impl::accelerator(int threads) const {
@@ -202,6 +196,32 @@ std::vector<std::string> Scene::layers() const {
     std::vector<std::string> names;
     for (const auto& layer : m_impl->description.layers) names.push_back(layer.value);
     return names;
+}
+std::string Scene::layers_location() const {
+    const auto& layers = m_impl->description.layers;
+    return layers.empty() ? std::string() : layers.front().where.str();
+}
+std::string Scene::intersection() const {
+    return m_impl->scene.intersection == Intersection::exact ? "exact" : "povray";
+}
+std::vector<std::string> Scene::mesh_files() const {
+    return m_impl->scene.mesh_files;
+}
+SceneCounts Scene::counts() const {
+    const whitted::Scene& scene = m_impl->scene;
+    return {scene.triangle_count(),
+            scene.spheres.size(),
+            scene.boxes.size(),
+            scene.planes.size(),
+            scene.lights.size(),
+            scene.instances.size(),
+            scene.instanced_triangle_count()};
+}
+double Scene::read_seconds() const {
+    return m_impl->read_seconds;
+}
+const Scene::Impl& impl_of(const Scene& scene) {
+    return *scene.m_impl;
 }
 
 /// The public overrides in the reader's terms; `intersection` is checked here.
@@ -415,6 +435,22 @@ Expected<Scene> SceneBuilder::build() const {
     });
 }
 
+Expected<void> check_render_options(const Scene& scene, const RenderOptions& options) {
+    return guarded<void>("checking the options for " + scene.path(), [&]() -> Expected<void> {
+        crop_window(scene, options);
+        layers_for(scene, options);
+        return {};
+    });
+}
+
+Expected<AcceleratorInfo> prepare(const Scene& scene, int threads) {
+    return guarded<AcceleratorInfo>("building the BVH of " + scene.path(), [&]() -> Expected<AcceleratorInfo> {
+        const Accelerator& accelerator = impl_of(scene).accelerator(threads);
+        return AcceleratorInfo{accelerator.embree_bytes(), accelerator.peak_embree_bytes(), accelerator.isa(),
+                               accelerator.lane_width()};
+    });
+}
+
 Expected<RenderResult> render(const Scene& scene, const RenderOptions& options) {
     return render_distributed(scene, options, nullptr);
 }
@@ -470,13 +506,13 @@ Expected<void> write_image(const Image& image, const std::string& path, const Wr
 
 Expected<std::string> to_povray(const Scene& scene) {
     return guarded<std::string>("converting " + scene.path(), [&]() -> Expected<std::string> {
-        return pov::scene_to_sdl(scene.impl().converter_description());
+        return pov::scene_to_sdl(impl_of(scene).converter_description());
     });
 }
 
 Expected<std::string> write_povray(const Scene& scene, const std::string& pov_path) {
     return guarded<std::string>("converting " + scene.path(), [&]() -> Expected<std::string> {
-        return pov::write_pov_files(scene.impl().converter_description(), pov_path);
+        return pov::write_pov_files(impl_of(scene).converter_description(), pov_path);
     });
 }
 

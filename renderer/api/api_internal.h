@@ -2,11 +2,11 @@
 #pragma once
 
 // The library's private side of whitted::api::Scene: the parsed description (the converters read
-// it) and the validated render Scene, with the BVH built once on demand. Only the library and the
-// `whitted` program (for --stats) include this; the public headers never do.
+// it) and the validated render Scene, with the BVH built once on demand. Only the library (and the
+// `whitted` program's `live`, which renders a description it edits, and `render` under MPI)
+// include this; the public headers never do.
 
 #include "whitted/render/accelerator.h"
-#include "whitted/render/layers.h"
 #include "whitted/render/work_exchange.h"
 #include "whitted/scene/description.h"
 #include "whitted/scene/scene.h"
@@ -38,9 +38,8 @@ private:
     mutable std::unique_ptr<Accelerator> m_accelerator;
 };
 
-/// Throws std::invalid_argument when the scene cannot have these render layers (a glazed
-/// material); the one statement of that rule, for api::render and `whitted render`'s usage check.
-void refuse_unsupported_layers(const whitted::Scene& scene, const LayerSet& layers);
+/// The private side of a Scene, for the library's own functions.
+const Scene::Impl& impl_of(const Scene& scene);
 
 /// api::render with the tiles shared among MPI ranks through `exchange` (null: one process), for
 /// `whitted render` under mpirun (docs/distributed.md); not in the public API yet. On a rank other

@@ -346,36 +346,38 @@ int run_render(const RenderArguments& args) {
     api::Expected<api::Scene> read = load_scene_argument(args.scene, args.overrides);
     if (!read) return api::report(read.error());
     loaded.emplace(std::move(read).value());
-    const api::Scene::Impl& impl = loaded->impl();
-    const SceneDescription& description = impl.description;
-    const Scene& scene = impl.scene;
+    const api::Scene& scene = *loaded;
     timer.lap();
+    api::RenderOptions options;
+    options.threads = args.threads;
+    options.layers = args.layers;  // empty: the scene's render.layers, as below
+    options.crop = crop;
+    options.cancel = &g_cancel;
     // What the scene asks that the output must allow.
     const auto check_scene_output = [&] {
-        if (args.layers.empty() && !description.layers.empty()) {
+        if (args.layers.empty() && !scene.layers().empty()) {
             // The scene's render.layers, unless --layers was given (--layers none turns them off).
             layers = parse_layers(loaded->layers());  // validated with the scene: the names are known
             if (!layers.empty()) {
-                output.layers_from = "render.layers at " + description.layers.front().where.str();
+                output.layers_from = "render.layers at " + scene.layers_location();
                 check_output_options(args.output, output);
             }
         }
-        for (const std::string& mesh : scene.mesh_files) refuse_output_over(args.output, mesh, "mesh file");
-        if (crop && (int64_t(crop->x) + crop->width > scene.width || int64_t(crop->y) + crop->height > scene.height))
+        for (const std::string& mesh : scene.mesh_files()) refuse_output_over(args.output, mesh, "mesh file");
+        if (crop &&
+            (int64_t(crop->x) + crop->width > scene.width() || int64_t(crop->y) + crop->height > scene.height()))
             throw std::invalid_argument("--crop " + args.crop + " does not lie inside the " +
-                                        std::to_string(scene.width) + "x" + std::to_string(scene.height) + " image");
-        api::refuse_unsupported_layers(scene, layers);
+                                        std::to_string(scene.width()) + "x" + std::to_string(scene.height()) +
+                                        " image");
     };
     if (const int status = exit_on_input_error(args.scene, check_scene_output); status >= 0) return status;
+    // The rest as api::render checks it (a glazed material cannot have layers), before the BVH.
+    if (const auto usable = api::check_render_options(scene, options); !usable) return api::report(usable.error());
 
     try {
-        const Accelerator& accelerator = impl.accelerator(args.threads);  // api::render uses this one
+        const api::Expected<api::AcceleratorInfo> accelerator = api::prepare(scene, args.threads);  // kept for render
+        if (!accelerator) return api::report(accelerator.error());
         const double build_seconds = timer.lap();
-        api::RenderOptions options;
-        options.threads = args.threads;
-        options.layers = args.layers;  // empty: the scene's render.layers, as above
-        options.crop = crop;
-        options.cancel = &g_cancel;
         const bool progress_bar = !args.quiet && ::isatty(STDERR_FILENO);
         if (progress_bar)
             options.on_progress = [](const api::Progress& p) {
@@ -386,7 +388,7 @@ int run_render(const RenderArguments& args) {
         api::Expected<api::RenderResult> rendered = api::Error{};
         {
             const CancelWatchdog watchdog;
-            rendered = api::render_distributed(*loaded, options, g_exchange.get());
+            rendered = api::render_distributed(scene, options, g_exchange.get());
         }
         if (progress_bar) std::fputc('\n', stderr);
         if (!rendered) return api::report(rendered.error());
@@ -411,10 +413,9 @@ int run_render(const RenderArguments& args) {
             {"whitted:scene", std::filesystem::path(args.scene).filename().string()},
             {"whitted:settings",
              fmt::format(
-                 "{}x{}{}, {} sample(s)/pixel, max depth {}, intersection {}", scene.width, scene.height,
+                 "{}x{}{}, {} sample(s)/pixel, max depth {}, intersection {}", scene.width(), scene.height(),
                  crop ? fmt::format(" cropped to {}x{} at {},{}", crop->width, crop->height, crop->x, crop->y) : "",
-                 scene.samples * scene.samples, scene.max_depth,
-                 scene.intersection == Intersection::exact ? "exact" : "povray")},
+                 scene.samples() * scene.samples(), scene.max_depth(), scene.intersection())},
             {"whitted:render_seconds", fmt::format("{:.3f}", result.stats.seconds)},
             {"whitted:rays", std::to_string(rays)}};
         if (result.cancelled) {
@@ -445,6 +446,7 @@ int run_render(const RenderArguments& args) {
                          "are that large\n",
                          beyond_float);
         const double total = timer.total();
+        const api::SceneCounts counts = scene.counts();
         if (args.stats)
             std::fprintf(
                 stderr,
@@ -452,20 +454,19 @@ int run_render(const RenderArguments& args) {
                 "%.3fs; "
                 "%zu triangles, %zu spheres, %zu boxes, %zu planes, %zu lights, %zu instances (%zu triangles seen); "
                 "BVH %.1f MB (%.1f MB while building); Embree %s, %d-wide packets\n",
-                impl.read_seconds, build_seconds, result.stats.seconds, write_seconds, scene.triangle_count(),
-                scene.spheres.size(), scene.boxes.size(), scene.planes.size(), scene.lights.size(),
-                scene.instances.size(), scene.instanced_triangle_count(), double(accelerator.embree_bytes()) / 1e6,
-                double(accelerator.peak_embree_bytes()) / 1e6,
-                accelerator.isa().empty() ? "(its choice)" : accelerator.isa().c_str(), accelerator.lane_width());
+                scene.read_seconds(), build_seconds, result.stats.seconds, write_seconds, counts.triangles,
+                counts.spheres, counts.boxes, counts.planes, counts.lights, counts.instances,
+                counts.instanced_triangles, double(accelerator->bytes) / 1e6, double(accelerator->peak_bytes) / 1e6,
+                accelerator->isa.empty() ? "(its choice)" : accelerator->isa.c_str(), accelerator->lane_width);
         if (!args.quiet)
             std::fprintf(
                 stderr,
                 "whitted: %dx%d%s, %d sample(s)/pixel, %u thread(s): render %.3fs (total %.3fs), %.2f M "
                 "rays (camera %.2f, shadow %.2f, reflected %.2f), %.1f M rays/s -> %s\n",
-                scene.width, scene.height,
+                scene.width(), scene.height(),
                 crop ? fmt::format(" cropped to {}x{} at {},{}", crop->width, crop->height, crop->x, crop->y).c_str()
                      : "",
-                scene.samples * scene.samples,
+                scene.samples() * scene.samples(),
                 args.threads > 0 ? unsigned(args.threads) : std::thread::hardware_concurrency(), result.stats.seconds,
                 total, rays / 1e6, result.stats.camera_rays / 1e6, result.stats.shadow_rays / 1e6,
                 result.stats.reflected_rays / 1e6, result.stats.seconds > 0 ? rays / result.stats.seconds / 1e6 : 0.0,

@@ -110,6 +110,14 @@ private:
     Error m_error;
 };
 
+/// How many of each thing a loaded scene holds.
+struct SceneCounts {
+    size_t triangles = 0;  ///< of the meshes and triangles, each mesh once
+    size_t spheres = 0, boxes = 0, planes = 0, lights = 0;
+    size_t instances = 0;            ///< placements of a mesh
+    size_t instanced_triangles = 0;  ///< triangles as the instances place them
+};
+
 /// A loaded, validated scene, ready to render (many times, from several threads at once). The
 /// acceleration structure (BVH) is built on the first render and kept. Move-only.
 class WHITTED_API Scene {
@@ -128,10 +136,19 @@ public:
     const std::string& path() const;
     /// render.layers as written in the scene (empty: none asked for).
     std::vector<std::string> layers() const;
-
-    Impl& impl() const { return *m_impl; }
+    /// Where render.layers is written, "FILE:LINE:COL" (for messages); empty when it is not.
+    std::string layers_location() const;
+    /// render.intersection: "exact" or "povray" (how hits are decided).
+    std::string intersection() const;
+    /// The mesh files the scene read, as resolved paths.
+    std::vector<std::string> mesh_files() const;
+    /// What the scene holds once loaded (a mesh's triangles counted once per mesh).
+    SceneCounts counts() const;
+    /// Wall time load_scene_* took: reading, validating and loading the meshes, seconds.
+    double read_seconds() const;
 
 private:
+    friend const Impl& impl_of(const Scene& scene);  ///< the library's own access
     std::unique_ptr<Impl> m_impl;
 };
 
@@ -237,6 +254,23 @@ struct RenderResult {
     RenderStats stats;
     bool cancelled = false;
 };
+
+/// Checks the options against the scene without rendering, as render() does first: the layers'
+/// names, that the scene can have them (not with a glazed, fresnel_ior, material yet) and that
+/// the crop window lies inside the image.
+WHITTED_API Expected<void> check_render_options(const Scene& scene, const RenderOptions& options = {});
+
+/// The BVH as built for the scene.
+struct AcceleratorInfo {
+    size_t bytes = 0;       ///< Embree's memory for it
+    size_t peak_bytes = 0;  ///< Embree's memory at most while building it
+    std::string isa;        ///< Embree's instruction set as asked ($WHITTED_EMBREE_ISA); empty: Embree's choice
+    int lane_width = 1;     ///< rays per packet given to Embree
+};
+
+/// Builds the scene's BVH now with `threads` build threads (0 = all cores), as the first render
+/// would (a Scene keeps it), and describes it.
+WHITTED_API Expected<AcceleratorInfo> prepare(const Scene& scene, int threads = 0);
 
 /// Renders the scene. Cancelling is not an error: the result says cancelled.
 WHITTED_API Expected<RenderResult> render(const Scene& scene, const RenderOptions& options = {});
