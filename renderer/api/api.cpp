@@ -166,10 +166,11 @@ const Accelerator& Scene::Impl::accelerator(int threads) const {
 }
 
 const SceneDescription& Scene::Impl::converter_description() const {
-    if (objects_kept) return description;
-    std::lock_guard lock(m_mutex);
-    if (!m_reread) m_reread = std::make_unique<SceneDescription>(parse_scene_file(description.path));
-    return *m_reread;
+    if (!objects_kept)
+        throw std::invalid_argument(
+            "the scene was loaded with SceneUse::render_only, which keeps no description of its objects to "
+            "convert: load it with SceneUse::any");
+    return description;
 }
 
 Scene::Scene(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
@@ -244,13 +245,18 @@ SettingOverrides setting_overrides(const SceneOverrides& given) {
     return overrides;
 }
 
-Expected<Scene> load_scene_file(const std::string& path, const SceneOverrides& overrides) {
-    // In one pass (scene.h): the objects are validated as they are read and their descriptions
-    // not kept, so a million spheres cost bytes each, not kilobytes; the converters read the
-    // file again (Scene::Impl::converter_description).
+Expected<Scene> load_scene_file(const std::string& path, const SceneOverrides& overrides, SceneUse use) {
     return load(path, [&](Scene::Impl& impl) {
-        impl.scene = whitted::load_scene_file(path, &impl.description, setting_overrides(overrides));
-        impl.objects_kept = false;
+        if (use == SceneUse::render_only) {
+            // In one pass (scene.h): the objects are validated as they are read and their
+            // descriptions not kept, so a million spheres cost bytes each, not kilobytes.
+            impl.scene = whitted::load_scene_file(path, &impl.description, setting_overrides(overrides));
+            impl.objects_kept = false;
+            return;
+        }
+        impl.description = parse_scene_file(path);
+        apply_overrides(setting_overrides(overrides), impl.description);
+        impl.scene = validate_scene(impl.description);
     });
 }
 

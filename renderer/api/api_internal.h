@@ -18,14 +18,14 @@
 namespace whitted::api {
 
 struct Scene::Impl {
-    /// What the file says; without its objects when `objects_kept` is false (load_scene_file
-    /// reads in one pass and lets each object's description go once validated).
+    /// What the file said when it was loaded; without its objects when `objects_kept` is false
+    /// (SceneUse::render_only: read in one pass, each object's description let go once validated).
     SceneDescription description;
     bool objects_kept = true;
     whitted::Scene scene;
     double read_seconds = 0;  ///< load_scene_*: reading, validating and loading meshes, wall time
 
-    /// The whole description, for the converters: `description`, or the file read again.
+    /// The whole description, for the converters; throws std::invalid_argument without its objects.
     const SceneDescription& converter_description() const;
 
     /// The BVH, built by the first caller with `threads` build threads (0 = all cores) and kept.
@@ -34,7 +34,6 @@ struct Scene::Impl {
 
 private:
     mutable std::mutex m_mutex;
-    mutable std::unique_ptr<SceneDescription> m_reread;
     mutable std::unique_ptr<Accelerator> m_accelerator;
 };
 

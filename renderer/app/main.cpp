@@ -243,7 +243,7 @@ api::PixelWindow parse_crop(const std::string& text) {
 /// whole, at most the scene file limit; relative mesh paths are then relative to the current
 /// directory, and the format is told by the first line: docs/scene-format.md).
 api::Expected<api::Scene> load_scene_argument(const std::string& scene, const api::SceneOverrides& overrides) {
-    if (scene != "-") return api::load_scene_file(scene, overrides);
+    if (scene != "-") return api::load_scene_file(scene, overrides, api::SceneUse::render_only);
     std::string text;
     char buffer[1 << 16];
     for (;;) {

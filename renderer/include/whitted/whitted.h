@@ -163,10 +163,22 @@ struct SceneOverrides {
     std::optional<std::string> intersection;  ///< render.intersection: "exact" or "povray"
 };
 
+/// What a loaded scene will be used for.
+enum class SceneUse {
+    /// Anything: the Scene keeps the description it was read from, and to_povray/write_povray
+    /// convert that (never the file again, which may have changed since).
+    any,
+    /// Rendering only: each object's description is let go once it is validated, so a file of a
+    /// million spheres costs bytes per sphere, not the description's hundreds (docs/performance.md,
+    /// "One pass"); to_povray/write_povray of such a Scene are an Error.
+    render_only,
+};
+
 /// Reads and validates a scene file: YAML or JSON scene format v1 (docs/scene-format.md), a
 /// Cornell CS4620 course .xml scene (docs/course-format.md) or an NFF scene (docs/nff.md). Mesh
-/// files are read too.
-WHITTED_API Expected<Scene> load_scene_file(const std::string& path, const SceneOverrides& overrides = {});
+/// files are read too. The file is read once.
+WHITTED_API Expected<Scene> load_scene_file(const std::string& path, const SceneOverrides& overrides = {},
+                                            SceneUse use = SceneUse::any);
 /// The same from text in memory; `name` stands for the file in messages, and relative mesh
 /// paths are resolved against its directory. The format is the one `name`'s extension says
 /// (.xml, .nff; .yaml, .yml, .json), else the one the text's first line says (NFF entities,
@@ -296,7 +308,8 @@ struct WriteOptions {
 /// file appears complete or not at all.
 WHITTED_API Expected<void> write_image(const Image& image, const std::string& path, const WriteOptions& options = {});
 
-/// The scene as POV-Ray 3.7 SDL (docs/pov-model.md), as `whitted convert s.yaml s.pov` writes it.
+/// The scene as POV-Ray 3.7 SDL (docs/pov-model.md), as `whitted convert s.yaml s.pov` writes it:
+/// the description it was loaded from (or built with), whatever its file says now.
 WHITTED_API Expected<std::string> to_povray(const Scene& scene);
 /// Writes `pov_path` and the .ini beside it that renders it like Whitted; returns the .ini path.
 WHITTED_API Expected<std::string> write_povray(const Scene& scene, const std::string& pov_path);
