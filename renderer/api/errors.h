@@ -15,6 +15,7 @@
 #include <new>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace whitted::api {
 
@@ -23,6 +24,9 @@ enum ExitStatus : int { exit_ok = 0, exit_failure = 1, exit_bad_input = 2 };
 
 /// What the work was, for the exceptions that do not say so themselves.
 struct ErrorContext {
+    ErrorContext(std::string doing_, std::string file_ = {}, Error::Kind otherwise_ = Error::Kind::failure)
+        : doing(std::move(doing_)), file(std::move(file_)), otherwise(otherwise_) {}
+
     /// Finishes "out of memory while ...", e.g. "rendering s.yaml".
     std::string doing;
     /// Named before the message of an exception that carries no place (a filesystem error, say);
