@@ -492,16 +492,21 @@ Expected<RenderStats> render_into(const Scene& scene, float* rgb, size_t floats,
     });
 }
 
+OutputOptions output_options(const WriteOptions& options) {
+    OutputOptions output;
+    output.half = options.half;
+    output.exr_compression = options.exr_compression;
+    output.bit_depth = options.bit_depth;
+    output.ocio_config = options.ocio_config;
+    output.display = options.display;
+    output.view = options.view;
+    output.metadata = options.metadata;
+    return output;
+}
+
 Expected<void> write_image(const Image& image, const std::string& path, const WriteOptions& options) {
     return guarded<void>("writing " + path, [&]() -> Expected<void> {
-        OutputOptions output;
-        output.half = options.half;
-        output.exr_compression = options.exr_compression;
-        output.bit_depth = options.bit_depth;
-        output.ocio_config = options.ocio_config;
-        output.display = options.display;
-        output.view = options.view;
-        output.metadata = options.metadata;
+        OutputOptions output = output_options(options);
         if (!image.layers.empty()) output.layers_from = "the image's layers";
         check_output_path(path);
         check_output_options(path, output);

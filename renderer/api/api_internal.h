@@ -6,6 +6,7 @@
 // `whitted` program's `live`, which renders a description it edits, and `render` under MPI)
 // include this; the public headers never do.
 
+#include "whitted/output/image_output.h"
 #include "whitted/render/accelerator.h"
 #include "whitted/render/work_exchange.h"
 #include "whitted/scene/description.h"
@@ -36,6 +37,10 @@ private:
     mutable std::mutex m_mutex;
     mutable std::unique_ptr<Accelerator> m_accelerator;
 };
+
+/// The writers' options from the public ones, for write_image and `whitted render`'s usage checks
+/// (which add where render layers were asked for).
+OutputOptions output_options(const WriteOptions& options);
 
 /// The private side of a Scene, for the library's own functions.
 const Scene::Impl& impl_of(const Scene& scene);

@@ -186,7 +186,7 @@ int terminal_columns() {
 
 /// One line that fits the terminal, redrawn in place: the bar shrinks (or goes) before the
 /// figures do, and a line never wraps (a wrapped line is left behind at every redraw).
-void draw_progress(const RenderProgress& p) {
+void draw_progress(const api::Progress& p) {
     const double fraction = p.tiles_total ? double(p.tiles_done) / double(p.tiles_total) : 1.0;
     const double rate = p.seconds > 0 ? double(p.rays) / p.seconds / 1e6 : 0.0;
     const double eta = fraction > 0 ? p.seconds * (1 - fraction) / fraction : 0.0;
@@ -211,10 +211,8 @@ void draw_progress(const RenderProgress& p) {
 struct RenderArguments {
     std::string scene, output = "whitted.png";
     int threads = 0;
-    bool quiet = false, half = false, partial = false, stats = false;
-    std::string exr_compression;  // empty: not given (none)
-    int bit_depth = 0;
-    std::string ocio_config, display, view;
+    bool quiet = false, partial = false, stats = false;
+    api::WriteOptions write;          // --half, --exr-compression, --bit-depth, --ocio-config, --display, --view
     std::vector<std::string> layers;  // --layers; empty: not given (the scene's render.layers)
     api::SceneOverrides overrides;    // --width, --height, --samples, --max-depth, --intersection
     std::string crop;                 // --crop X,Y,WIDTH,HEIGHT; empty: the whole image
@@ -261,17 +259,6 @@ api::Expected<api::Scene> load_scene_argument(const std::string& scene, const ap
         text.append(buffer, size_t(n));
     }
     return api::load_scene_string(text, "<stdin>", overrides);
-}
-
-OutputOptions output_options(const RenderArguments& args) {
-    OutputOptions output;
-    output.half = args.half;
-    output.exr_compression = args.exr_compression;
-    output.bit_depth = args.bit_depth;
-    output.ocio_config = args.ocio_config;
-    output.display = args.display;
-    output.view = args.view;
-    return output;
 }
 
 /// Refuses an output that is one of the render's input files (`whitted render s.png -o s.png`
@@ -326,7 +313,7 @@ int run_render(const RenderArguments& args) {
         }
     }
     install_signal_handlers();
-    OutputOptions output = output_options(args);
+    OutputOptions output = api::output_options(args.write);
     LayerSet layers;
     std::optional<api::Scene> loaded;
     // Usage first, in milliseconds: nothing here reads the scene.
@@ -381,7 +368,7 @@ int run_render(const RenderArguments& args) {
         const bool progress_bar = !args.quiet && ::isatty(STDERR_FILENO);
         if (progress_bar)
             options.on_progress = [](const api::Progress& p) {
-                draw_progress({p.tiles_done, p.tiles_total, p.rays, p.seconds});
+                draw_progress(p);
                 return true;
             };
         g_exit_on_signal.store(false);  // from here on a signal cancels, and we clean up
@@ -401,13 +388,7 @@ int run_render(const RenderArguments& args) {
         timer.lap();
 
         // The scene's file name only: a file sent on should not carry this machine's paths.
-        api::WriteOptions write;
-        write.half = output.half;
-        write.exr_compression = output.exr_compression;
-        write.bit_depth = output.bit_depth;
-        write.ocio_config = output.ocio_config;
-        write.display = output.display;
-        write.view = output.view;
+        api::WriteOptions write = args.write;
         const uint64_t rays = result.stats.camera_rays + result.stats.shadow_rays + result.stats.reflected_rays;
         write.metadata = {
             {"whitted:scene", std::filesystem::path(args.scene).filename().string()},
@@ -675,22 +656,22 @@ int main(int argc, char** argv) {
     render_cmd->add_option("-t,--threads", render_args.threads, "Worker threads (default: all cores)")
         ->check(CLI::Range(0, 4096));
     render_cmd->add_flag("-q,--quiet", render_args.quiet, "No progress bar and no summary line");
-    render_cmd->add_flag("--half", render_args.half, "EXR: write half floats instead of 32-bit floats");
+    render_cmd->add_flag("--half", render_args.write.half, "EXR: write half floats instead of 32-bit floats");
     render_cmd
-        ->add_option("--exr-compression", render_args.exr_compression,
+        ->add_option("--exr-compression", render_args.write.exr_compression,
                      "EXR compression, all lossless: none (the default, fastest to write), zip, zips, piz, rle")
         ->check(CLI::IsMember({"none", "zip", "zips", "piz", "rle"}));
     render_cmd
-        ->add_option("--bit-depth", render_args.bit_depth,
+        ->add_option("--bit-depth", render_args.write.bit_depth,
                      "PNG/TIFF bits per channel, 8 or 16 (default: PNG 8, TIFF 16; JPEG is 8 only)")
         ->check(CLI::IsMember({8, 16}));
-    render_cmd->add_option("--ocio-config", render_args.ocio_config,
+    render_cmd->add_option("--ocio-config", render_args.write.ocio_config,
                            "PNG/JPEG/TIFF: OpenColorIO config file (default: $OCIO, else the built-in config; "
                            "`whitted colour --list` shows it)");
-    render_cmd->add_option("--display", render_args.display,
+    render_cmd->add_option("--display", render_args.write.display,
                            "PNG/JPEG/TIFF: OCIO display, e.g. sRGB, 'Gamma 2.2', BT.1886, 'Display P3' "
                            "(default: the config's default)");
-    render_cmd->add_option("--view", render_args.view,
+    render_cmd->add_option("--view", render_args.write.view,
                            "PNG/JPEG/TIFF: OCIO view, e.g. Standard, Raw (default: the display's default)");
     render_cmd->add_flag("--stats", render_args.stats,
                          "Print the time of each stage (parse, load, BVH, render, write) and the BVH's memory");
