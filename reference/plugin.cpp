@@ -3,6 +3,7 @@
 // Its entry points are looked up by name with dlsym; both sides are built together by the same
 // compiler, so they pass C++ types.
 
+#include "api/errors.h"
 #include "reference/check.h"
 #include "reference/file_colour.h"
 #include "whitted/scene/source_location.h"
@@ -19,6 +20,16 @@
 #include <utility>
 #include <vector>
 
+namespace {
+
+/// What `check` throws: a scene or an option it cannot check with is the caller's input (POV-Ray
+/// missing included), as for every command.
+whitted::api::ErrorContext check_context(const std::string& scene_path) {
+    return {"checking " + scene_path, "", whitted::api::Error::Kind::bad_input};
+}
+
+}  // namespace
+
 extern "C" {
 
 /// `whitted check`: returns the exit status (0 pass, 1 images differ, 2 cannot check, 128 +
@@ -32,15 +43,8 @@ __attribute__((visibility("default"))) int whitted_run_check(const std::string& 
     } catch (const whitted::reference::Interrupted&) {
         std::fprintf(stderr, "whitted: interrupted; POV-Ray stopped, temporary files removed\n");
         return 128 + (signal.load() ? signal.load() : SIGINT);
-    } catch (const whitted::InputError& e) {
-        std::fprintf(stderr, "whitted: error: %s\n", e.what());
-        return 2;
-    } catch (const std::bad_alloc&) {
-        std::fprintf(stderr, "whitted: error: out of memory while checking %s\n", scene_path.c_str());
-        return 1;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "whitted: error: %s\n", e.what());
-        return 2;
+    } catch (...) {
+        return whitted::api::report(whitted::api::current_error(check_context(scene_path)));
     }
 }
 
@@ -55,21 +59,9 @@ __attribute__((visibility("default"))) int whitted_api_check(const std::string& 
         result = whitted::reference::run_check(scene_path, options);
         verdict = whitted::reference::verdict_line(scene_path, result, options);
         return 0;
-    } catch (const whitted::InputError& e) {
-        error.message = e.message();
-        error.file = e.where().file.str();
-        error.line = e.where().line;
-        error.column = e.where().column;
-        return 2;
-    } catch (const std::bad_alloc&) {
-        error.message = "out of memory while checking " + scene_path;
-        return 1;
-    } catch (const std::invalid_argument& e) {
-        error.message = e.what();
-        return 2;
-    } catch (const std::exception& e) {
-        error.message = e.what();
-        return 1;
+    } catch (...) {
+        error = whitted::api::current_error(check_context(scene_path));
+        return whitted::api::exit_status(error);
     }
 }
 
@@ -117,13 +109,10 @@ __attribute__((visibility("default"))) int whitted_run_compare(const std::string
         std::snprintf(rms, sizeof rms, ", RMS %.3g", c.rms_error);
         std::printf("%s\n", verdict_text(subject, figures + rms, failures).c_str());
         return failures.empty() ? 0 : 1;
-    } catch (const std::bad_alloc&) {
-        std::fprintf(stderr, "whitted: error: out of memory while comparing %s and %s\n", first.c_str(),
-                     second.c_str());
-        return 1;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "whitted: error: %s\n", e.what());
-        return 2;
+    } catch (...) {
+        // An image that cannot be read or decoded is the caller's input.
+        return whitted::api::report(whitted::api::current_error(
+            {"comparing " + first + " and " + second, "", whitted::api::Error::Kind::bad_input}));
     }
 }
 

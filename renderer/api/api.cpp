@@ -3,6 +3,7 @@
 // turned into an Error value here, with the location an InputError carries.
 
 #include "api/api_internal.h"
+#include "api/errors.h"
 #include "converters/pov_writer.h"
 #include "reference/check.h"
 #include "whitted/core/plugin.h"
@@ -30,41 +31,26 @@ double seconds_since(clock::time_point start) {
     return std::chrono::duration<double>(clock::now() - start).count();
 }
 
-Error input_error(const InputError& e) {
-    Error error;
-    error.message = e.message();
-    error.file = e.where().file.str();
-    error.line = e.where().line;
-    error.column = e.where().column;
-    return error;
-}
-
-Error plain_error(std::string message, Error::Kind kind, std::string file = {}) {
+Error plain_error(std::string message, Error::Kind kind) {
     Error error;
     error.message = std::move(message);
     error.kind = kind;
-    error.file = std::move(file);
     return error;
 }
 
-/// Runs `work`, turning what it throws into an Error: InputError and std::invalid_argument are the
-/// caller's input (bad_input), anything else a failure. `what` finishes "out of memory while ...".
+/// Runs `work`, turning what it throws into an Error (api/errors.h); `what` finishes "out of
+/// memory while ...".
 template <class T, class Work>
 Expected<T> guarded(const std::string& what, Work&& work) {
     try {
         return work();
-    } catch (const InputError& e) {
-        return input_error(e);
-    } catch (const std::invalid_argument& e) {
-        return plain_error(e.what(), Error::Kind::bad_input);
-    } catch (const std::bad_alloc&) {
-        return plain_error("out of memory while " + what, Error::Kind::failure);
-    } catch (const std::exception& e) {
-        return plain_error(e.what(), Error::Kind::failure);
+    } catch (...) {
+        return current_error({what});
     }
 }
 
-/// `read` fills the description and the validated scene of a new Scene::Impl.
+/// `read` fills the description and the validated scene of a new Scene::Impl. An error without
+/// a place names `label`; one reading a file (a filesystem error) is the caller's input.
 Expected<Scene> load(const std::string& label, const std::function<void(Scene::Impl&)>& read) {
     try {
         auto impl = std::make_unique<Scene::Impl>();
@@ -72,32 +58,20 @@ Expected<Scene> load(const std::string& label, const std::function<void(Scene::I
         read(*impl);
         impl->read_seconds = seconds_since(start);
         return Scene(std::move(impl));
-    } catch (const InputError& e) {
-        return input_error(e);
-    } catch (const std::invalid_argument& e) {
-        return plain_error(e.what(), Error::Kind::bad_input);
-    } catch (const std::bad_alloc&) {
-        // A scene or mesh too large for this machine's memory: an error, never an abort.
-        return plain_error("out of memory while reading the scene", Error::Kind::failure, label);
-    } catch (const FileChangedWhileRead& e) {
-        // Not the input's fault: another program changed it under the reader (exit 1).
-        return plain_error(e.what(), Error::Kind::failure, label);
-    } catch (const std::exception& e) {  // e.g. a filesystem error while reading
-        return plain_error(e.what(), Error::Kind::bad_input, label);
+    } catch (...) {
+        return current_error({"reading the scene", label, Error::Kind::bad_input});
     }
 }
 
 /// The layers a render computes: the options', else the scene's render.layers.
 LayerSet layers_for(const Scene& scene, const RenderOptions& options) {
-    const SceneDescription& description = scene.impl().description;
     std::vector<std::string> names = options.layers;
-    if (names.empty())
-        for (const auto& layer : description.layers) names.push_back(layer.value);
+    if (names.empty()) names = scene.layers();
     const LayerSet layers = parse_layers(names);
     // The colour layers split each hit's terms at weight 1; a glazed (fresnel_ior) material
     // scales them by 1 − F, which the layers do not yet follow, so they would not add up.
     if (!layers.empty())
-        for (const whitted::Material& material : scene.impl().scene.materials)
+        for (const whitted::Material& material : impl_of(scene).scene.materials)
             if (material.fresnel_r0 >= 0)
                 throw std::invalid_argument(
                     "render layers are not available for scenes with a fresnel_ior (glazed) material yet");
@@ -120,7 +94,7 @@ std::optional<TileRect> crop_window(const Scene& scene, const RenderOptions& opt
 whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& options, LayerSet layers,
                                       WorkExchange* exchange = nullptr) {
     const std::optional<TileRect> crop = crop_window(scene, options);
-    const Accelerator& accelerator = scene.impl().accelerator(options.threads);
+    const Accelerator& accelerator = impl_of(scene).accelerator(options.threads);
     // The progress callback may cancel too: then one flag of ours for both, set by either (the
     // caller's copied in by a watcher); without a callback the tiles check the caller's own.
     std::atomic<bool> stop{options.cancel && options.cancel->load()};
@@ -146,8 +120,8 @@ whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& o
         };
     whitted::RenderResult result;
     try {
-        result = exchange ? whitted::render_distributed(scene.impl().scene, accelerator, internal, *exchange)
-                          : whitted::render(scene.impl().scene, accelerator, internal);
+        result = exchange ? whitted::render_distributed(impl_of(scene).scene, accelerator, internal, *exchange)
+                          : whitted::render(impl_of(scene).scene, accelerator, internal);
     } catch (...) {
         watching.store(false);
         if (watcher.joinable()) watcher.join();
@@ -192,10 +166,11 @@ const Accelerator& Scene::Impl::accelerator(int threads) const {
 }
 
 const SceneDescription& Scene::Impl::converter_description() const {
-    if (objects_kept) return description;
-    std::lock_guard lock(m_mutex);
-    if (!m_reread) m_reread = std::make_unique<SceneDescription>(parse_scene_file(description.path));
-    return *m_reread;
+    if (!objects_kept)
+        throw std::invalid_argument(
+            "the scene was loaded with SceneUse::render_only, which keeps no description of its objects to "
+            "convert: load it with SceneUse::any");
+    return description;
 }
 
 Scene::Scene(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
@@ -223,6 +198,32 @@ std::vector<std::string> Scene::layers() const {
     for (const auto& layer : m_impl->description.layers) names.push_back(layer.value);
     return names;
 }
+std::string Scene::layers_location() const {
+    const auto& layers = m_impl->description.layers;
+    return layers.empty() ? std::string() : layers.front().where.str();
+}
+std::string Scene::intersection() const {
+    return m_impl->scene.intersection == Intersection::exact ? "exact" : "povray";
+}
+std::vector<std::string> Scene::mesh_files() const {
+    return m_impl->scene.mesh_files;
+}
+SceneCounts Scene::counts() const {
+    const whitted::Scene& scene = m_impl->scene;
+    return {scene.triangle_count(),
+            scene.spheres.size(),
+            scene.boxes.size(),
+            scene.planes.size(),
+            scene.lights.size(),
+            scene.instances.size(),
+            scene.instanced_triangle_count()};
+}
+double Scene::read_seconds() const {
+    return m_impl->read_seconds;
+}
+const Scene::Impl& impl_of(const Scene& scene) {
+    return *scene.m_impl;
+}
 
 /// The public overrides in the reader's terms; `intersection` is checked here.
 SettingOverrides setting_overrides(const SceneOverrides& given) {
@@ -244,13 +245,18 @@ SettingOverrides setting_overrides(const SceneOverrides& given) {
     return overrides;
 }
 
-Expected<Scene> load_scene_file(const std::string& path, const SceneOverrides& overrides) {
-    // In one pass (scene.h): the objects are validated as they are read and their descriptions
-    // not kept, so a million spheres cost bytes each, not kilobytes; the converters read the
-    // file again (Scene::Impl::converter_description).
+Expected<Scene> load_scene_file(const std::string& path, const SceneOverrides& overrides, SceneUse use) {
     return load(path, [&](Scene::Impl& impl) {
-        impl.scene = whitted::load_scene_file(path, &impl.description, setting_overrides(overrides));
-        impl.objects_kept = false;
+        if (use == SceneUse::render_only) {
+            // In one pass (scene.h): the objects are validated as they are read and their
+            // descriptions not kept, so a million spheres cost bytes each, not kilobytes.
+            impl.scene = whitted::load_scene_file(path, &impl.description, setting_overrides(overrides));
+            impl.objects_kept = false;
+            return;
+        }
+        impl.description = parse_scene_file(path);
+        apply_overrides(setting_overrides(overrides), impl.description);
+        impl.scene = validate_scene(impl.description);
     });
 }
 
@@ -424,15 +430,30 @@ SceneBuilder& SceneBuilder::triangle(Vec3 a, Vec3 b, Vec3 c, const Material& mat
 
 Expected<Scene> SceneBuilder::build() const {
     const Impl& impl = *m_impl;
-    const FileName file("<SceneBuilder>");
-    if (!impl.image_call)
-        return input_error(InputError({file, 0, 0}, "no image(width, height) given: the scene needs its size"));
-    if (!impl.camera_call)
-        return input_error(InputError({file, 0, 0}, "no camera(eye, look_at) given: the scene needs a camera"));
-    if (impl.first_error) return input_error(*impl.first_error);
     return load("<SceneBuilder>", [&](Scene::Impl& built) {
+        const FileName file("<SceneBuilder>");
+        if (!impl.image_call) throw InputError({file, 0, 0}, "no image(width, height) given: the scene needs its size");
+        if (!impl.camera_call)
+            throw InputError({file, 0, 0}, "no camera(eye, look_at) given: the scene needs a camera");
+        if (impl.first_error) throw *impl.first_error;
         built.description = impl.description;
         built.scene = validate_scene(built.description);
+    });
+}
+
+Expected<void> check_render_options(const Scene& scene, const RenderOptions& options) {
+    return guarded<void>("checking the options for " + scene.path(), [&]() -> Expected<void> {
+        crop_window(scene, options);
+        layers_for(scene, options);
+        return {};
+    });
+}
+
+Expected<AcceleratorInfo> prepare(const Scene& scene, int threads) {
+    return guarded<AcceleratorInfo>("building the BVH of " + scene.path(), [&]() -> Expected<AcceleratorInfo> {
+        const Accelerator& accelerator = impl_of(scene).accelerator(threads);
+        return AcceleratorInfo{accelerator.embree_bytes(), accelerator.peak_embree_bytes(), accelerator.isa(),
+                               accelerator.lane_width()};
     });
 }
 
@@ -471,16 +492,21 @@ Expected<RenderStats> render_into(const Scene& scene, float* rgb, size_t floats,
     });
 }
 
+OutputOptions output_options(const WriteOptions& options) {
+    OutputOptions output;
+    output.half = options.half;
+    output.exr_compression = options.exr_compression;
+    output.bit_depth = options.bit_depth;
+    output.ocio_config = options.ocio_config;
+    output.display = options.display;
+    output.view = options.view;
+    output.metadata = options.metadata;
+    return output;
+}
+
 Expected<void> write_image(const Image& image, const std::string& path, const WriteOptions& options) {
     return guarded<void>("writing " + path, [&]() -> Expected<void> {
-        OutputOptions output;
-        output.half = options.half;
-        output.exr_compression = options.exr_compression;
-        output.bit_depth = options.bit_depth;
-        output.ocio_config = options.ocio_config;
-        output.display = options.display;
-        output.view = options.view;
-        output.metadata = options.metadata;
+        OutputOptions output = output_options(options);
         if (!image.layers.empty()) output.layers_from = "the image's layers";
         check_output_path(path);
         check_output_options(path, output);
@@ -491,13 +517,13 @@ Expected<void> write_image(const Image& image, const std::string& path, const Wr
 
 Expected<std::string> to_povray(const Scene& scene) {
     return guarded<std::string>("converting " + scene.path(), [&]() -> Expected<std::string> {
-        return pov::scene_to_sdl(scene.impl().converter_description());
+        return pov::scene_to_sdl(impl_of(scene).converter_description());
     });
 }
 
 Expected<std::string> write_povray(const Scene& scene, const std::string& pov_path) {
     return guarded<std::string>("converting " + scene.path(), [&]() -> Expected<std::string> {
-        return pov::write_pov_files(scene.impl().converter_description(), pov_path);
+        return pov::write_pov_files(impl_of(scene).converter_description(), pov_path);
     });
 }
 

@@ -2,9 +2,11 @@
 #pragma once
 
 // The library's private side of whitted::api::Scene: the parsed description (the converters read
-// it) and the validated render Scene, with the BVH built once on demand. Only the library and the
-// `whitted` program (for --stats) include this; the public headers never do.
+// it) and the validated render Scene, with the BVH built once on demand. Only the library (and the
+// `whitted` program's `live`, which renders a description it edits, and `render` under MPI)
+// include this; the public headers never do.
 
+#include "whitted/output/image_output.h"
 #include "whitted/render/accelerator.h"
 #include "whitted/render/work_exchange.h"
 #include "whitted/scene/description.h"
@@ -17,14 +19,14 @@
 namespace whitted::api {
 
 struct Scene::Impl {
-    /// What the file says; without its objects when `objects_kept` is false (load_scene_file
-    /// reads in one pass and lets each object's description go once validated).
+    /// What the file said when it was loaded; without its objects when `objects_kept` is false
+    /// (SceneUse::render_only: read in one pass, each object's description let go once validated).
     SceneDescription description;
     bool objects_kept = true;
     whitted::Scene scene;
     double read_seconds = 0;  ///< load_scene_*: reading, validating and loading meshes, wall time
 
-    /// The whole description, for the converters: `description`, or the file read again.
+    /// The whole description, for the converters; throws std::invalid_argument without its objects.
     const SceneDescription& converter_description() const;
 
     /// The BVH, built by the first caller with `threads` build threads (0 = all cores) and kept.
@@ -33,9 +35,15 @@ struct Scene::Impl {
 
 private:
     mutable std::mutex m_mutex;
-    mutable std::unique_ptr<SceneDescription> m_reread;
     mutable std::unique_ptr<Accelerator> m_accelerator;
 };
+
+/// The writers' options from the public ones, for write_image and `whitted render`'s usage checks
+/// (which add where render layers were asked for).
+OutputOptions output_options(const WriteOptions& options);
+
+/// The private side of a Scene, for the library's own functions.
+const Scene::Impl& impl_of(const Scene& scene);
 
 /// api::render with the tiles shared among MPI ranks through `exchange` (null: one process), for
 /// `whitted render` under mpirun (docs/distributed.md); not in the public API yet. On a rank other

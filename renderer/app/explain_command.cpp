@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "explain_command.h"
 
+#include "api/errors.h"
 #include "whitted/render/accelerator.h"
 #include "whitted/render/explain.h"
 #include "whitted/scene/description.h"
@@ -20,7 +21,7 @@ namespace whitted {
 
 namespace {
 
-constexpr int exit_ok = 0, exit_failure = 1, exit_bad_input = 2;
+using api::exit_ok;
 
 /// "X,Y" → two non-negative integers; throws std::invalid_argument saying what is wrong.
 void parse_pixel(const std::string& text, int& x, int& y) {
@@ -343,10 +344,6 @@ void name_non_finite_numbers(nlohmann::json& j) {
     }
 }
 
-void print_error(const std::string& message) {
-    std::fprintf(stderr, "whitted: error: %s\n", message.c_str());
-}
-
 }  // namespace
 
 int run_explain(const std::string& scene_path, const std::string& pixel, bool json, bool summary, int threads) {
@@ -358,15 +355,8 @@ int run_explain(const std::string& scene_path, const std::string& pixel, bool js
         if (x >= scene.width || y >= scene.height)
             throw std::invalid_argument(fmt::format("--pixel {},{} is outside the {}x{} image (X 0..{}, Y 0..{})", x, y,
                                                     scene.width, scene.height, scene.width - 1, scene.height - 1));
-    } catch (const InputError& e) {
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::invalid_argument& e) {
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::exception& e) {
-        print_error(scene_path + ": " + e.what());
-        return exit_bad_input;
+    } catch (...) {
+        return api::report(api::current_error({"reading the scene", scene_path, api::Error::Kind::bad_input}));
     }
     try {
         const Accelerator accelerator(scene, threads);
@@ -381,12 +371,8 @@ int run_explain(const std::string& scene_path, const std::string& pixel, bool js
             print_summary(scene, scene_path, explanation);
         else
             print_text(scene, scene_path, explanation);
-    } catch (const InputError& e) {  // e.g. a shape beyond the range the accelerator takes
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::exception& e) {
-        print_error(scene_path + ": " + e.what());
-        return exit_failure;
+    } catch (...) {  // e.g. an InputError: a shape beyond the range the accelerator takes
+        return api::report(api::current_error({"explaining a pixel of " + scene_path, scene_path}));
     }
     return exit_ok;
 }

@@ -8,6 +8,7 @@
 #include "live_command.h"
 
 #include "api/api_internal.h"
+#include "api/errors.h"
 #include "live_page_html.h"
 #include "whitted/scene/description.h"
 #include "whitted/scene/scene.h"
@@ -44,7 +45,7 @@ namespace {
 
 using json = nlohmann::json;
 
-constexpr int exit_failure = 1, exit_bad_input = 2;
+using api::exit_bad_input, api::exit_failure;
 
 /// A mistake in what the page sent (HTTP 400), as opposed to one in the scene file (422).
 struct BadRequest : std::invalid_argument {
@@ -421,12 +422,10 @@ int run_live(const LiveArguments& args) {
             response.set_content(rendered.bytes, format == "exr" ? "image/x-exr" : "image/png");
         } catch (const BadRequest& e) {
             send_error(response, 400, e.what());
-        } catch (const InputError& e) {  // a page value the scene format refuses, at its place in the file
-            send_error(response, 422, e.what());
-        } catch (const std::invalid_argument& e) {
-            send_error(response, 422, e.what());
-        } catch (const std::exception& e) {
-            send_error(response, 500, e.what());
+        } catch (...) {
+            // Bad input is a page value the scene format refuses, at its place in the file.
+            const api::Error error = api::current_error({"rendering " + state.path()});
+            send_error(response, error.kind == api::Error::Kind::bad_input ? 422 : 500, error.what());
         }
     });
 

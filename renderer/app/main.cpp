@@ -4,6 +4,7 @@
 // (0 ok, 1 failure while rendering or checking, 2 bad input or usage, 130/143 interrupted).
 
 #include "api/api_internal.h"
+#include "api/errors.h"
 #include "converters/pov_writer.h"
 #include "converters/yaml_writer.h"
 #include "explain_command.h"
@@ -51,7 +52,7 @@ namespace {
 
 using namespace whitted;
 
-constexpr int exit_ok = 0, exit_failure = 1, exit_bad_input = 2;
+using api::exit_bad_input, api::exit_failure, api::exit_ok;
 
 std::atomic<bool> g_cancel{false};
 std::atomic<int> g_signal{0};
@@ -185,7 +186,7 @@ int terminal_columns() {
 
 /// One line that fits the terminal, redrawn in place: the bar shrinks (or goes) before the
 /// figures do, and a line never wraps (a wrapped line is left behind at every redraw).
-void draw_progress(const RenderProgress& p) {
+void draw_progress(const api::Progress& p) {
     const double fraction = p.tiles_total ? double(p.tiles_done) / double(p.tiles_total) : 1.0;
     const double rate = p.seconds > 0 ? double(p.rays) / p.seconds / 1e6 : 0.0;
     const double eta = fraction > 0 ? p.seconds * (1 - fraction) / fraction : 0.0;
@@ -210,10 +211,8 @@ void draw_progress(const RenderProgress& p) {
 struct RenderArguments {
     std::string scene, output = "whitted.png";
     int threads = 0;
-    bool quiet = false, half = false, partial = false, stats = false;
-    std::string exr_compression;  // empty: not given (none)
-    int bit_depth = 0;
-    std::string ocio_config, display, view;
+    bool quiet = false, partial = false, stats = false;
+    api::WriteOptions write;          // --half, --exr-compression, --bit-depth, --ocio-config, --display, --view
     std::vector<std::string> layers;  // --layers; empty: not given (the scene's render.layers)
     api::SceneOverrides overrides;    // --width, --height, --samples, --max-depth, --intersection
     std::string crop;                 // --crop X,Y,WIDTH,HEIGHT; empty: the whole image
@@ -242,7 +241,7 @@ api::PixelWindow parse_crop(const std::string& text) {
 /// whole, at most the scene file limit; relative mesh paths are then relative to the current
 /// directory, and the format is told by the first line: docs/scene-format.md).
 api::Expected<api::Scene> load_scene_argument(const std::string& scene, const api::SceneOverrides& overrides) {
-    if (scene != "-") return api::load_scene_file(scene, overrides);
+    if (scene != "-") return api::load_scene_file(scene, overrides, api::SceneUse::render_only);
     std::string text;
     char buffer[1 << 16];
     for (;;) {
@@ -260,17 +259,6 @@ api::Expected<api::Scene> load_scene_argument(const std::string& scene, const ap
         text.append(buffer, size_t(n));
     }
     return api::load_scene_string(text, "<stdin>", overrides);
-}
-
-OutputOptions output_options(const RenderArguments& args) {
-    OutputOptions output;
-    output.half = args.half;
-    output.exr_compression = args.exr_compression;
-    output.bit_depth = args.bit_depth;
-    output.ocio_config = args.ocio_config;
-    output.display = args.display;
-    output.view = args.view;
-    return output;
 }
 
 /// Refuses an output that is one of the render's input files (`whitted render s.png -o s.png`
@@ -297,28 +285,17 @@ private:
     std::chrono::steady_clock::time_point m_start = std::chrono::steady_clock::now(), m_last = m_start;
 };
 
-/// Runs `work`; a mistake in the input it throws is printed as `whitted` prints it, and the exit
-/// status returned (−1: none). `scene` names the file for errors that do not carry a place (a
-/// filesystem error, say).
+/// Runs `work`, a check before the render; what it throws is printed as `whitted` prints it, and
+/// the exit status returned (−1: none). `scene` names the file for errors that do not carry a
+/// place (a filesystem error, say).
 template <class Work>
 int exit_on_input_error(const std::string& scene, Work&& work) {
     try {
         work();
         return -1;
-    } catch (const InputError& e) {
-        print_error(e.what());
-    } catch (const std::invalid_argument& e) {
-        print_error(e.what());
-    } catch (const std::exception& e) {
-        print_error(scene + ": " + e.what());
+    } catch (...) {
+        return api::report(api::current_error({"checking " + scene, scene, api::Error::Kind::bad_input}));
     }
-    return exit_bad_input;
-}
-
-/// The API's error, printed as `whitted` always has; its exit status.
-int report(const api::Error& error) {
-    print_error(error.what());
-    return error.kind == api::Error::Kind::bad_input ? exit_bad_input : exit_failure;
 }
 
 /// `whitted render`: a user of the public API (whitted/whitted.h) for loading, rendering and
@@ -329,13 +306,14 @@ int run_render(const RenderArguments& args) {
     if (const std::string evidence = mpi_launch_evidence(); !evidence.empty()) {
         try {
             g_exchange = open_mpi_exchange();
-        } catch (const std::exception& e) {
-            print_error(std::string(e.what()) + " (this process was started as an MPI rank: " + evidence + ")");
-            return exit_failure;
+        } catch (...) {
+            api::Error error = api::current_error({"starting MPI"});
+            error.message += " (this process was started as an MPI rank: " + evidence + ")";
+            return api::report(error);
         }
     }
     install_signal_handlers();
-    OutputOptions output = output_options(args);
+    OutputOptions output = api::output_options(args.write);
     LayerSet layers;
     std::optional<api::Scene> loaded;
     // Usage first, in milliseconds: nothing here reads the scene.
@@ -353,58 +331,54 @@ int run_render(const RenderArguments& args) {
     };
     if (const int status = exit_on_input_error(args.scene, check_usage); status >= 0) return status;
     api::Expected<api::Scene> read = load_scene_argument(args.scene, args.overrides);
-    if (!read) return report(read.error());
+    if (!read) return api::report(read.error());
     loaded.emplace(std::move(read).value());
-    const api::Scene::Impl& impl = loaded->impl();
-    const SceneDescription& description = impl.description;
-    const Scene& scene = impl.scene;
+    const api::Scene& scene = *loaded;
     timer.lap();
+    api::RenderOptions options;
+    options.threads = args.threads;
+    options.layers = args.layers;  // empty: the scene's render.layers, as below
+    options.crop = crop;
+    options.cancel = &g_cancel;
     // What the scene asks that the output must allow.
     const auto check_scene_output = [&] {
-        if (args.layers.empty() && !description.layers.empty()) {
+        if (args.layers.empty() && !scene.layers().empty()) {
             // The scene's render.layers, unless --layers was given (--layers none turns them off).
             layers = parse_layers(loaded->layers());  // validated with the scene: the names are known
             if (!layers.empty()) {
-                output.layers_from = "render.layers at " + description.layers.front().where.str();
+                output.layers_from = "render.layers at " + scene.layers_location();
                 check_output_options(args.output, output);
             }
         }
-        for (const std::string& mesh : scene.mesh_files) refuse_output_over(args.output, mesh, "mesh file");
-        if (crop && (int64_t(crop->x) + crop->width > scene.width || int64_t(crop->y) + crop->height > scene.height))
+        for (const std::string& mesh : scene.mesh_files()) refuse_output_over(args.output, mesh, "mesh file");
+        if (crop &&
+            (int64_t(crop->x) + crop->width > scene.width() || int64_t(crop->y) + crop->height > scene.height()))
             throw std::invalid_argument("--crop " + args.crop + " does not lie inside the " +
-                                        std::to_string(scene.width) + "x" + std::to_string(scene.height) + " image");
-        // The colour layers split each hit's terms at weight 1; a glazed (fresnel_ior) material
-        // scales them by 1 − F, which the layers do not yet follow, so they would not add up.
-        if (!layers.empty())
-            for (const Material& material : scene.materials)
-                if (material.fresnel_r0 >= 0)
-                    throw std::invalid_argument(
-                        "render layers are not available for scenes with a fresnel_ior (glazed) material yet");
+                                        std::to_string(scene.width()) + "x" + std::to_string(scene.height()) +
+                                        " image");
     };
     if (const int status = exit_on_input_error(args.scene, check_scene_output); status >= 0) return status;
+    // The rest as api::render checks it (a glazed material cannot have layers), before the BVH.
+    if (const auto usable = api::check_render_options(scene, options); !usable) return api::report(usable.error());
 
     try {
-        const Accelerator& accelerator = impl.accelerator(args.threads);  // api::render uses this one
+        const api::Expected<api::AcceleratorInfo> accelerator = api::prepare(scene, args.threads);  // kept for render
+        if (!accelerator) return api::report(accelerator.error());
         const double build_seconds = timer.lap();
-        api::RenderOptions options;
-        options.threads = args.threads;
-        options.layers = args.layers;  // empty: the scene's render.layers, as above
-        options.crop = crop;
-        options.cancel = &g_cancel;
         const bool progress_bar = !args.quiet && ::isatty(STDERR_FILENO);
         if (progress_bar)
             options.on_progress = [](const api::Progress& p) {
-                draw_progress({p.tiles_done, p.tiles_total, p.rays, p.seconds});
+                draw_progress(p);
                 return true;
             };
         g_exit_on_signal.store(false);  // from here on a signal cancels, and we clean up
         api::Expected<api::RenderResult> rendered = api::Error{};
         {
             const CancelWatchdog watchdog;
-            rendered = api::render_distributed(*loaded, options, g_exchange.get());
+            rendered = api::render_distributed(scene, options, g_exchange.get());
         }
         if (progress_bar) std::fputc('\n', stderr);
-        if (!rendered) return report(rendered.error());
+        if (!rendered) return api::report(rendered.error());
         const api::RenderResult& result = rendered.value();
         if (g_exchange && g_exchange->rank() != 0)  // its tiles are with rank 0, which writes the image
             return result.cancelled ? 128 + (g_signal.load() ? g_signal.load() : SIGINT) : exit_ok;
@@ -414,22 +388,15 @@ int run_render(const RenderArguments& args) {
         timer.lap();
 
         // The scene's file name only: a file sent on should not carry this machine's paths.
-        api::WriteOptions write;
-        write.half = output.half;
-        write.exr_compression = output.exr_compression;
-        write.bit_depth = output.bit_depth;
-        write.ocio_config = output.ocio_config;
-        write.display = output.display;
-        write.view = output.view;
+        api::WriteOptions write = args.write;
         const uint64_t rays = result.stats.camera_rays + result.stats.shadow_rays + result.stats.reflected_rays;
         write.metadata = {
             {"whitted:scene", std::filesystem::path(args.scene).filename().string()},
             {"whitted:settings",
              fmt::format(
-                 "{}x{}{}, {} sample(s)/pixel, max depth {}, intersection {}", scene.width, scene.height,
+                 "{}x{}{}, {} sample(s)/pixel, max depth {}, intersection {}", scene.width(), scene.height(),
                  crop ? fmt::format(" cropped to {}x{} at {},{}", crop->width, crop->height, crop->x, crop->y) : "",
-                 scene.samples * scene.samples, scene.max_depth,
-                 scene.intersection == Intersection::exact ? "exact" : "povray")},
+                 scene.samples() * scene.samples(), scene.max_depth(), scene.intersection())},
             {"whitted:render_seconds", fmt::format("{:.3f}", result.stats.seconds)},
             {"whitted:rays", std::to_string(rays)}};
         if (result.cancelled) {
@@ -437,7 +404,7 @@ int run_render(const RenderArguments& args) {
             if (args.partial) {
                 write.metadata.push_back({"whitted:partial", "true: interrupted; unfinished tiles are black"});
                 if (const auto written = api::write_image(result.image, args.output, write); !written)
-                    return report(written.error());
+                    return api::report(written.error());
                 std::fprintf(stderr, "whitted: interrupted; partial image (unfinished tiles black) written to %s\n",
                              args.output.c_str());
             } else {
@@ -447,7 +414,7 @@ int run_render(const RenderArguments& args) {
             return 128 + (signal ? signal : SIGINT);
         }
         if (const auto written = api::write_image(result.image, args.output, write); !written)
-            return report(written.error());
+            return api::report(written.error());
         const double write_seconds = timer.lap();
         // Radiance past the largest float is +inf in the image, as IEEE arithmetic has it: said,
         // because only a scene of enormous colours, intensities or mirror weights gets there.
@@ -460,6 +427,7 @@ int run_render(const RenderArguments& args) {
                          "are that large\n",
                          beyond_float);
         const double total = timer.total();
+        const api::SceneCounts counts = scene.counts();
         if (args.stats)
             std::fprintf(
                 stderr,
@@ -467,37 +435,26 @@ int run_render(const RenderArguments& args) {
                 "%.3fs; "
                 "%zu triangles, %zu spheres, %zu boxes, %zu planes, %zu lights, %zu instances (%zu triangles seen); "
                 "BVH %.1f MB (%.1f MB while building); Embree %s, %d-wide packets\n",
-                impl.read_seconds, build_seconds, result.stats.seconds, write_seconds, scene.triangle_count(),
-                scene.spheres.size(), scene.boxes.size(), scene.planes.size(), scene.lights.size(),
-                scene.instances.size(), scene.instanced_triangle_count(), double(accelerator.embree_bytes()) / 1e6,
-                double(accelerator.peak_embree_bytes()) / 1e6,
-                accelerator.isa().empty() ? "(its choice)" : accelerator.isa().c_str(), accelerator.lane_width());
+                scene.read_seconds(), build_seconds, result.stats.seconds, write_seconds, counts.triangles,
+                counts.spheres, counts.boxes, counts.planes, counts.lights, counts.instances,
+                counts.instanced_triangles, double(accelerator->bytes) / 1e6, double(accelerator->peak_bytes) / 1e6,
+                accelerator->isa.empty() ? "(its choice)" : accelerator->isa.c_str(), accelerator->lane_width);
         if (!args.quiet)
             std::fprintf(
                 stderr,
                 "whitted: %dx%d%s, %d sample(s)/pixel, %u thread(s): render %.3fs (total %.3fs), %.2f M "
                 "rays (camera %.2f, shadow %.2f, reflected %.2f), %.1f M rays/s -> %s\n",
-                scene.width, scene.height,
+                scene.width(), scene.height(),
                 crop ? fmt::format(" cropped to {}x{} at {},{}", crop->width, crop->height, crop->x, crop->y).c_str()
                      : "",
-                scene.samples * scene.samples,
+                scene.samples() * scene.samples(),
                 args.threads > 0 ? unsigned(args.threads) : std::thread::hardware_concurrency(), result.stats.seconds,
                 total, rays / 1e6, result.stats.camera_rays / 1e6, result.stats.shadow_rays / 1e6,
                 result.stats.reflected_rays / 1e6, result.stats.seconds > 0 ? rays / result.stats.seconds / 1e6 : 0.0,
                 args.output.c_str());
         return exit_ok;
-    } catch (const InputError& e) {  // e.g. a shape beyond the range the accelerator takes
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::invalid_argument& e) {
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::bad_alloc&) {
-        print_error("out of memory while rendering " + args.scene);
-        return exit_failure;
-    } catch (const std::exception& e) {
-        print_error(e.what());
-        return exit_failure;
+    } catch (...) {  // e.g. an InputError: a shape beyond the range the accelerator takes
+        return api::report(api::current_error({"rendering " + args.scene}));
     }
 }
 
@@ -551,15 +508,8 @@ int run_convert(const std::string& scene_path, const std::string& output) {
         const std::string ini = pov::write_pov_files(description, output);
         std::fprintf(stderr, "whitted: wrote %s and %s\n", output.c_str(), ini.c_str());
         return exit_ok;
-    } catch (const InputError& e) {
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::invalid_argument& e) {
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::exception& e) {
-        print_error(e.what());
-        return exit_failure;
+    } catch (...) {
+        return api::report(api::current_error({"converting " + scene_path}));
     }
 }
 
@@ -575,9 +525,8 @@ int run_check_command(const std::string& scene_path, reference::CheckOptions opt
     try {
         const auto run_check = reinterpret_cast<RunCheck>(image_io_plugin_symbol("whitted_run_check"));
         return run_check(scene_path, options, g_signal);
-    } catch (const std::exception& e) {
-        print_error(e.what());
-        return exit_bad_input;
+    } catch (...) {  // the plug-in cannot be loaded
+        return api::report(api::current_error({"checking " + scene_path, "", api::Error::Kind::bad_input}));
     }
 }
 
@@ -587,9 +536,9 @@ int run_compare_command(const std::string& first, const std::string& second, con
     try {
         const auto run_compare = reinterpret_cast<RunCompare>(image_io_plugin_symbol("whitted_run_compare"));
         return run_compare(first, second, rule, clip);
-    } catch (const std::exception& e) {
-        print_error(e.what());
-        return exit_bad_input;
+    } catch (...) {  // the plug-in cannot be loaded
+        return api::report(
+            api::current_error({"comparing " + first + " and " + second, "", api::Error::Kind::bad_input}));
     }
 }
 
@@ -606,12 +555,8 @@ int run_colour(bool list, const std::string& config, const std::string& write_co
         }
         if (list) std::fputs(DisplayTransform::describe_config(config).c_str(), stdout);
         return exit_ok;
-    } catch (const std::invalid_argument& e) {
-        print_error(e.what());
-        return exit_bad_input;
-    } catch (const std::exception& e) {
-        print_error(e.what());
-        return exit_failure;
+    } catch (...) {
+        return api::report(api::current_error({"writing the colour config"}));
     }
 }
 
@@ -656,8 +601,8 @@ bool embree_isa_usable() {
     try {
         require_embree_isa(embree_isa_from_environment());
         return true;
-    } catch (const std::exception& e) {
-        print_error(e.what());
+    } catch (...) {
+        api::report(api::current_error({"checking WHITTED_EMBREE_ISA", "", api::Error::Kind::bad_input}));
         return false;
     }
 }
@@ -710,22 +655,22 @@ int main(int argc, char** argv) {
     render_cmd->add_option("-t,--threads", render_args.threads, "Worker threads (default: all cores)")
         ->check(CLI::Range(0, 4096));
     render_cmd->add_flag("-q,--quiet", render_args.quiet, "No progress bar and no summary line");
-    render_cmd->add_flag("--half", render_args.half, "EXR: write half floats instead of 32-bit floats");
+    render_cmd->add_flag("--half", render_args.write.half, "EXR: write half floats instead of 32-bit floats");
     render_cmd
-        ->add_option("--exr-compression", render_args.exr_compression,
+        ->add_option("--exr-compression", render_args.write.exr_compression,
                      "EXR compression, all lossless: none (the default, fastest to write), zip, zips, piz, rle")
         ->check(CLI::IsMember({"none", "zip", "zips", "piz", "rle"}));
     render_cmd
-        ->add_option("--bit-depth", render_args.bit_depth,
+        ->add_option("--bit-depth", render_args.write.bit_depth,
                      "PNG/TIFF bits per channel, 8 or 16 (default: PNG 8, TIFF 16; JPEG is 8 only)")
         ->check(CLI::IsMember({8, 16}));
-    render_cmd->add_option("--ocio-config", render_args.ocio_config,
+    render_cmd->add_option("--ocio-config", render_args.write.ocio_config,
                            "PNG/JPEG/TIFF: OpenColorIO config file (default: $OCIO, else the built-in config; "
                            "`whitted colour --list` shows it)");
-    render_cmd->add_option("--display", render_args.display,
+    render_cmd->add_option("--display", render_args.write.display,
                            "PNG/JPEG/TIFF: OCIO display, e.g. sRGB, 'Gamma 2.2', BT.1886, 'Display P3' "
                            "(default: the config's default)");
-    render_cmd->add_option("--view", render_args.view,
+    render_cmd->add_option("--view", render_args.write.view,
                            "PNG/JPEG/TIFF: OCIO view, e.g. Standard, Raw (default: the display's default)");
     render_cmd->add_flag("--stats", render_args.stats,
                          "Print the time of each stage (parse, load, BVH, render, write) and the BVH's memory");
@@ -938,9 +883,8 @@ int main(int argc, char** argv) {
     }
     try {
         check_options.layers = parse_layers(check_layers);
-    } catch (const std::invalid_argument& e) {
-        print_error(e.what());
-        return exit_bad_input;
+    } catch (...) {
+        return api::report(api::current_error({"reading --layers", "", api::Error::Kind::bad_input}));
     }
     check_options.rule.tolerance = tolerance_codes / 65535.0;
     check_options.rule.max_error = max_error_codes / 65535.0;

@@ -210,6 +210,24 @@ def test_to_povray_and_write_povray(tmp_path):
     assert (tmp_path / "s.pov").read_text() == sdl
 
 
+def test_to_povray_converts_the_scene_as_loaded(tmp_path):
+    # The SDL is the loaded scene's even when its file has changed since (a different sphere now).
+    path = tmp_path / "changing.yaml"
+    with open(SHADOWS) as f:
+        original = f.read()
+    path.write_text(original)
+    scene = whitted.load(str(path))
+    path.write_text(original.replace("objects:", "objects:\n  - {type: sphere, center: [7, 7, 7], radius: 0.25, material: sphere}", 1))
+    changed = whitted.to_povray(whitted.load(str(path)))
+    path.write_text(original)
+    loaded = whitted.to_povray(whitted.load(str(path)))
+    assert changed != loaded, "the change does not show in the SDL: the test proves nothing"
+    path.write_text(original.replace("objects:", "objects:\n  - {type: sphere, center: [7, 7, 7], radius: 0.25, material: sphere}", 1))
+    assert whitted.to_povray(scene) == loaded
+    whitted.write_povray(scene, str(tmp_path / "s.pov"))
+    assert (tmp_path / "s.pov").read_text() == loaded
+
+
 def test_check_against_povray():
     povray = os.environ.get("WHITTED_POVRAY") or "povray"
     if subprocess.run(["sh", "-c", f"command -v {povray}"], capture_output=True).returncode != 0:

@@ -110,6 +110,14 @@ private:
     Error m_error;
 };
 
+/// How many of each thing a loaded scene holds.
+struct SceneCounts {
+    size_t triangles = 0;  ///< of the meshes and triangles, each mesh once
+    size_t spheres = 0, boxes = 0, planes = 0, lights = 0;
+    size_t instances = 0;            ///< placements of a mesh
+    size_t instanced_triangles = 0;  ///< triangles as the instances place them
+};
+
 /// A loaded, validated scene, ready to render (many times, from several threads at once). The
 /// acceleration structure (BVH) is built on the first render and kept. Move-only.
 class WHITTED_API Scene {
@@ -128,10 +136,19 @@ public:
     const std::string& path() const;
     /// render.layers as written in the scene (empty: none asked for).
     std::vector<std::string> layers() const;
-
-    Impl& impl() const { return *m_impl; }
+    /// Where render.layers is written, "FILE:LINE:COL" (for messages); empty when it is not.
+    std::string layers_location() const;
+    /// render.intersection: "exact" or "povray" (how hits are decided).
+    std::string intersection() const;
+    /// The mesh files the scene read, as resolved paths.
+    std::vector<std::string> mesh_files() const;
+    /// What the scene holds once loaded (a mesh's triangles counted once per mesh).
+    SceneCounts counts() const;
+    /// Wall time load_scene_* took: reading, validating and loading the meshes, seconds.
+    double read_seconds() const;
 
 private:
+    friend const Impl& impl_of(const Scene& scene);  ///< the library's own access
     std::unique_ptr<Impl> m_impl;
 };
 
@@ -146,10 +163,22 @@ struct SceneOverrides {
     std::optional<std::string> intersection;  ///< render.intersection: "exact" or "povray"
 };
 
+/// What a loaded scene will be used for.
+enum class SceneUse {
+    /// Anything: the Scene keeps the description it was read from, and to_povray/write_povray
+    /// convert that (never the file again, which may have changed since).
+    any,
+    /// Rendering only: each object's description is let go once it is validated, so a file of a
+    /// million spheres costs bytes per sphere, not the description's hundreds (docs/performance.md,
+    /// "One pass"); to_povray/write_povray of such a Scene are an Error.
+    render_only,
+};
+
 /// Reads and validates a scene file: YAML or JSON scene format v1 (docs/scene-format.md), a
 /// Cornell CS4620 course .xml scene (docs/course-format.md) or an NFF scene (docs/nff.md). Mesh
-/// files are read too.
-WHITTED_API Expected<Scene> load_scene_file(const std::string& path, const SceneOverrides& overrides = {});
+/// files are read too. The file is read once.
+WHITTED_API Expected<Scene> load_scene_file(const std::string& path, const SceneOverrides& overrides = {},
+                                            SceneUse use = SceneUse::any);
 /// The same from text in memory; `name` stands for the file in messages, and relative mesh
 /// paths are resolved against its directory. The format is the one `name`'s extension says
 /// (.xml, .nff; .yaml, .yml, .json), else the one the text's first line says (NFF entities,
@@ -238,6 +267,23 @@ struct RenderResult {
     bool cancelled = false;
 };
 
+/// Checks the options against the scene without rendering, as render() does first: the layers'
+/// names, that the scene can have them (not with a glazed, fresnel_ior, material yet) and that
+/// the crop window lies inside the image.
+WHITTED_API Expected<void> check_render_options(const Scene& scene, const RenderOptions& options = {});
+
+/// The BVH as built for the scene.
+struct AcceleratorInfo {
+    size_t bytes = 0;       ///< Embree's memory for it
+    size_t peak_bytes = 0;  ///< Embree's memory at most while building it
+    std::string isa;        ///< Embree's instruction set as asked ($WHITTED_EMBREE_ISA); empty: Embree's choice
+    int lane_width = 1;     ///< rays per packet given to Embree
+};
+
+/// Builds the scene's BVH now with `threads` build threads (0 = all cores), as the first render
+/// would (a Scene keeps it), and describes it.
+WHITTED_API Expected<AcceleratorInfo> prepare(const Scene& scene, int threads = 0);
+
 /// Renders the scene. Cancelling is not an error: the result says cancelled.
 WHITTED_API Expected<RenderResult> render(const Scene& scene, const RenderOptions& options = {});
 /// Renders the beauty into the caller's buffer: `floats` must be width·height·3 (R G B per
@@ -262,7 +308,8 @@ struct WriteOptions {
 /// file appears complete or not at all.
 WHITTED_API Expected<void> write_image(const Image& image, const std::string& path, const WriteOptions& options = {});
 
-/// The scene as POV-Ray 3.7 SDL (docs/pov-model.md), as `whitted convert s.yaml s.pov` writes it.
+/// The scene as POV-Ray 3.7 SDL (docs/pov-model.md), as `whitted convert s.yaml s.pov` writes it:
+/// the description it was loaded from (or built with), whatever its file says now.
 WHITTED_API Expected<std::string> to_povray(const Scene& scene);
 /// Writes `pov_path` and the .ini beside it that renders it like Whitted; returns the .ini path.
 WHITTED_API Expected<std::string> write_povray(const Scene& scene, const std::string& pov_path);
