@@ -13,8 +13,6 @@
 #include "whitted/core/ray.h"
 #include "whitted/geometry/shapes.h"
 #include "whitted/output/atomic_files.h"
-#include "whitted/scene/mesh_file.h"
-#include "whitted/scene/msh_file.h"
 #include "whitted/scene/scene.h"
 #include "whitted/scene/text_checks.h"
 
@@ -141,15 +139,83 @@ std::string matrix(const Transform& t) {
            ", " + num(m[11]) + ">";
 }
 
-/// Walks the description as validate_scene does (same transforms, same materials), writing SDL.
+/// Writes the objects of the Scene that validate_scene (or load_scene_file) built from the
+/// description: its one walk of the description has folded every transform, resolved every
+/// material and read every mesh file, so the SDL holds the very numbers Whitted renders (the
+/// world-space planes, the float vertices about each mesh's origin) and no file is read here.
 class SdlWriter {
 public:
-    SdlWriter(const SceneDescription& description, std::string& out) : m_description(description), m_out(out) {
-        for (const auto& material : description.materials) m_named[material.name] = to_material(material);
+    SdlWriter(const SceneDescription& description, const Scene& scene, std::string& out) : m_scene(scene), m_out(out) {
+        // The cylinders' and cones' caps as the file gives them: the Scene keeps the base, the
+        // unit axis and the height, whose sum rounds. Prototypes hold no cones, so the
+        // description's, in file order, are the Scene's.
+        std::function<void(const std::vector<ObjectDescription>&)> caps = [&](const auto& list) {
+            for (const ObjectDescription& object : list) {
+                if (object.type == ObjectType::cylinder || object.type == ObjectType::cone)
+                    m_caps.push_back(object.cap.value);
+                caps(object.children);
+            }
+        };
+        caps(description.objects);
+        // Each object's place in the list of its kind (objects are numbered from 1, file order).
+        m_shape.assign(scene.objects.size(), 0);
+        const auto number = [&](const auto& shapes) {
+            for (size_t i = 0; i < shapes.size(); ++i)
+                if (shapes[i].object != 0) m_shape[shapes[i].object - 1] = static_cast<uint32_t>(i);
+        };
+        number(scene.spheres), number(scene.boxes), number(scene.cones), number(scene.planes);
+        number(scene.meshes), number(scene.instances);
     }
 
-    void objects(const std::vector<ObjectDescription>& list, const Transform& parent) {
-        for (const auto& object : list) write(object, parent);
+    /// The scene's objects, in file order (depth first through groups).
+    void objects() {
+        for (size_t id = 0; id < m_scene.objects.size(); ++id) {
+            const uint32_t i = m_shape[id];
+            switch (m_scene.objects[id].type) {
+                case ObjectType::sphere: {
+                    const Sphere& s = m_scene.spheres[i];
+                    m_out += "sphere { " + vec(s.center) + ", " + num(s.radius) + "\n    " +
+                             texture(m_scene.materials[s.material]) + "\n   " +
+                             matrix(transform_of(s.object_to_world)) + " }\n";
+                    break;
+                }
+                case ObjectType::box:
+                    box(m_scene.boxes[i]);
+                    break;
+                case ObjectType::cylinder: {
+                    // POV-Ray's own cylinder: base, cap, radius, `open` for no end caps.
+                    const Cone& c = m_scene.cones[i];
+                    m_out += "cylinder { " + vec(c.base) + ", " + vec(cap(i)) + ", " + num(c.base_radius) +
+                             (c.open ? " open" : "") + "\n    " + texture(m_scene.materials[c.material]) + "\n   " +
+                             matrix(transform_of(c.object_to_world)) + " }\n";
+                    break;
+                }
+                case ObjectType::cone: {
+                    const Cone& c = m_scene.cones[i];
+                    m_out += "cone { " + vec(c.base) + ", " + num(c.base_radius) + ", " + vec(cap(i)) + ", " +
+                             num(c.cap_radius) + (c.open ? " open" : "") + "\n    " +
+                             texture(m_scene.materials[c.material]) + "\n   " +
+                             matrix(transform_of(c.object_to_world)) + " }\n";
+                    break;
+                }
+                case ObjectType::plane: {
+                    // Whitted's world-space plane; POV's `plane { n, d }` is n·x = d.
+                    const Plane& p = m_scene.planes[i];
+                    m_out += "plane { " + vec(p.normal) + ", " + num(dot(p.normal, p.point)) + "\n    " +
+                             texture(m_scene.materials[p.material]) + " }\n";
+                    break;
+                }
+                case ObjectType::triangle:
+                case ObjectType::mesh:
+                    for (const Part& part : parts(m_scene.meshes[i])) mesh(m_scene.meshes[i], part);
+                    break;
+                case ObjectType::instance:
+                    instance(m_scene.instances[i]);
+                    break;
+                case ObjectType::group:  // never an object: its members are
+                    break;
+            }
+        }
     }
 
     /// Each prototype as POV-Ray shares it: every mesh2 of it `#declare`d once, in the
@@ -157,26 +223,16 @@ public:
     /// gives its own texture and transform while POV-Ray keeps one copy of the triangles
     /// (copies of a mesh share its data). Only prototypes that some instance places.
     void prototype_declarations() {
-        const auto& prototypes = m_description.prototypes;
+        const auto& prototypes = m_scene.prototypes;
         m_pieces.assign(prototypes.size(), {});
-        // Whether an instance in `list` (or in its groups) places prototype `name`; with
-        // `without_material`, one that gives no material of its own: only then do the defaults
-        // of the prototype's OBJ files show (and their warnings say something true).
-        std::function<bool(const std::vector<ObjectDescription>&, const std::string&, bool)> places =
-            [&](const auto& list, const std::string& name, bool without_material) {
-                for (const auto& object : list)
-                    if ((object.type == ObjectType::instance && object.prototype.value == name &&
-                         !(without_material && object.material)) ||
-                        places(object.children, name, without_material))
-                        return true;
-                return false;
-            };
+        std::vector<bool> placed(prototypes.size(), false);
+        for (const Instance& instance : m_scene.instances) placed[instance.prototype] = true;
         for (size_t i = 0; i < prototypes.size(); ++i) {
-            if (!places(m_description.objects, prototypes[i].name, false)) continue;
+            if (!placed[i]) continue;
             m_out += "// prototype " + comment_safe(prototypes[i].name) + "\n";
             m_collect = &m_pieces[i];
-            m_collect_shows_defaults = places(m_description.objects, prototypes[i].name, true);
-            write(prototypes[i].object, Transform());
+            for (const TriangleMesh& triangles : prototypes[i].meshes)
+                for (const Part& part : parts(triangles)) mesh(triangles, part);
             m_collect = nullptr;
             for (size_t k = 0; k < m_pieces[i].size(); ++k) {
                 m_out += "#declare " + piece_name(i, k) + " =\n" + m_pieces[i][k].sdl;
@@ -192,93 +248,55 @@ private:
         std::optional<Material> material;
     };
 
+    /// The triangles of a mesh that share a material: one mesh2 each (a mesh from a file with
+    /// its MTL materials becomes one mesh2 per material, each with all the mesh's vertices).
+    struct Part {
+        std::vector<std::array<uint32_t, 3>> triangles;
+        uint32_t material = Instance::no_material;  ///< no_material: left to each instance
+    };
+
+    /// In the order of the materials' numbers: an OBJ file's MTL materials are numbered in the
+    /// order the file lists them.
+    static std::vector<Part> parts(const TriangleMesh& mesh) {
+        std::map<uint32_t, std::vector<std::array<uint32_t, 3>>> by_material;
+        for (size_t t = 0; t < mesh.triangle_count(); ++t)
+            by_material[mesh.triangle_materials.empty() ? mesh.material : mesh.triangle_materials[t]].push_back(
+                {mesh.indices[3 * t], mesh.indices[3 * t + 1], mesh.indices[3 * t + 2]});
+        std::vector<Part> out;
+        for (auto& [material, triangles] : by_material) out.push_back({std::move(triangles), material});
+        return out;
+    }
+
+    /// A description whose objects went into the Scene as they were read (load_scene_file's
+    /// `settings`) holds none: its cones' caps are then base + height·axis, to a rounding.
+    Vec3 cap(uint32_t cone) const {
+        const Cone& c = m_scene.cones[cone];
+        return cone < m_caps.size() ? m_caps[cone] : c.base + c.axis * c.height;
+    }
+
+    std::optional<Material> material_if_any(uint32_t material) const {
+        if (material == Instance::no_material) return std::nullopt;
+        return m_scene.materials[material];
+    }
+
     static std::string piece_name(size_t prototype, size_t piece) {
         return "whitted_prototype_" + std::to_string(prototype) + "_" + std::to_string(piece);
     }
 
-    void instance(const ObjectDescription& object, const Transform& to_world) {
-        size_t index = 0;
-        while (m_description.prototypes[index].name != object.prototype.value) ++index;  // validate_scene checked it
+    void instance(const Instance& placement) {
+        const size_t index = placement.prototype;
         const std::vector<Piece>& pieces = m_pieces[index];
-        const std::optional<Material> override =
-            object.material ? std::optional<Material>(material_of(object)) : std::nullopt;
+        const std::optional<Material> override = material_if_any(placement.material);
         const auto placed = [&](size_t k) {
             return "object { " + piece_name(index, k) + "\n    " + texture(override ? *override : *pieces[k].material);
         };
         if (pieces.size() == 1) {
-            m_out += placed(0) + "\n   " + matrix(to_world) + " }\n";
+            m_out += placed(0) + "\n   " + matrix(placement.object_to_world) + " }\n";
             return;
         }
         m_out += "union {\n";
         for (size_t k = 0; k < pieces.size(); ++k) m_out += "  " + placed(k) + " }\n";
-        m_out += " " + matrix(to_world) + " }\n";
-    }
-
-    static Material to_material(const MaterialDescription& d) {
-        Material m{d.ka.value, d.kd.value, d.ks.value, d.p.value, d.km.value, d.highlight.value};
-        m.kt = d.kt.value;
-        m.ior = d.ior.value;
-        return m;
-    }
-
-    /// In a prototype a mesh may leave its material to the instances.
-    std::optional<Material> material_if_given(const ObjectDescription& object) const {
-        if (!object.material) return std::nullopt;
-        return material_of(object);
-    }
-
-    Material material_of(const ObjectDescription& object) const {
-        const MaterialReference& reference = *object.material;  // validate_scene has checked it is there
-        if (reference.inline_) return to_material(*reference.inline_);
-        return m_named.at(reference.name);
-    }
-
-    void write(const ObjectDescription& object, const Transform& parent) {
-        const Transform to_world = make_transform(object.transform).then(parent);
-        switch (object.type) {
-            case ObjectType::sphere:
-                m_out += "sphere { " + vec(object.center.value) + ", " + num(object.radius.value) + "\n    " +
-                         texture(material_of(object)) + "\n   " + matrix(to_world) + " }\n";
-                break;
-            case ObjectType::box:
-                box(object, to_world);
-                break;
-            case ObjectType::cylinder:
-                // POV-Ray's own cylinder: base, cap, radius, `open` for no end caps.
-                m_out += "cylinder { " + vec(object.base.value) + ", " + vec(object.cap.value) + ", " +
-                         num(object.radius.value) + (object.open.value ? " open" : "") + "\n    " +
-                         texture(material_of(object)) + "\n   " + matrix(to_world) + " }\n";
-                break;
-            case ObjectType::cone:
-                m_out += "cone { " + vec(object.base.value) + ", " + num(object.base_radius.value) + ", " +
-                         vec(object.cap.value) + ", " + num(object.cap_radius.value) +
-                         (object.open.value ? " open" : "") + "\n    " + texture(material_of(object)) + "\n   " +
-                         matrix(to_world) + " }\n";
-                break;
-            case ObjectType::plane: {
-                // World-space plane computed exactly as Whitted does; POV's `plane { n, d }` is n·x = d.
-                const Vec3 normal = unit_direction(to_world.apply_normal(object.normal.value));
-                const Vec3 point = to_world.apply_point(object.point.value);
-                m_out += "plane { " + vec(normal) + ", " + num(dot(normal, point)) + "\n    " +
-                         texture(material_of(object)) + " }\n";
-                break;
-            }
-            case ObjectType::triangle:
-                mesh(object.vertices, {}, {{0, 1, 2}}, to_world, material_if_given(object));
-                break;
-            case ObjectType::mesh:
-                if (object.file.given)
-                    mesh_file(object, to_world);
-                else
-                    mesh(object.vertices, object.normals, object.triangles, to_world, material_if_given(object));
-                break;
-            case ObjectType::group:
-                objects(object.children, to_world);
-                break;
-            case ObjectType::instance:
-                instance(object, to_world);
-                break;
-        }
+        m_out += " " + matrix(placement.object_to_world) + " }\n";
     }
 
     /// A box, in a union that gives POV-Ray a bounding box sure to hold it. POV-Ray keeps each
@@ -292,80 +310,44 @@ private:
     /// union's box hold the whole box (povray_box_corners, which PovrayTestOrder also uses to
     /// rebuild POV-Ray's bounding boxes). `split_union off` keeps POV-Ray from replacing the
     /// union by its children; a union tests its children without their own bounding boxes.
-    void box(const ObjectDescription& object, const Transform& to_world) {
+    void box(const Box& b) {
+        const Transform& to_world = transform_of(b.object_to_world);
         Vec3 lo, hi;
-        povray_box_corners(to_world, object.min.value, object.max.value, lo, hi);
-        m_out += "union { box { " + vec(object.min.value) + ", " + vec(object.max.value) + "\n    " +
-                 texture(material_of(object)) + "\n   " + matrix(to_world) + " }\n    sphere { " + vec(lo) +
-                 ", 0 } sphere { " + vec(hi) + ", 0 } split_union off }\n";
+        povray_box_corners(to_world, b.min, b.max, lo, hi);
+        m_out += "union { box { " + vec(b.min) + ", " + vec(b.max) + "\n    " + texture(m_scene.materials[b.material]) +
+                 "\n   " + matrix(to_world) + " }\n    sphere { " + vec(lo) + ", 0 } sphere { " + vec(hi) +
+                 ", 0 } split_union off }\n";
     }
 
-    void mesh_file(const ObjectDescription& object, const Transform& to_world) {
-        const bool msh = std::filesystem::path(object.file_path).extension() == ".msh";
-        // As validate_scene loads it: with the object's own material the MTL files are not read.
-        const MeshData data = msh ? load_msh_mesh(object.file_path, object.file.where)
-                                  : load_obj_mesh(object.file_path, object.file.where, 0, !object.material);
-        if (!m_collect || m_collect_shows_defaults) print_mesh_warnings(data);
-        std::vector<Vec3> vertices, normals;
-        for (size_t i = 0; i < data.positions.size() / 3; ++i)
-            vertices.push_back({data.positions[3 * i], data.positions[3 * i + 1], data.positions[3 * i + 2]});
-        for (size_t i = 0; i < data.normals.size() / 3; ++i)
-            normals.push_back({data.normals[3 * i], data.normals[3 * i + 1], data.normals[3 * i + 2]});
-        // One mesh2 per material: the MTL's, or the scene's override for all faces.
-        std::map<int32_t, std::vector<std::array<int64_t, 3>>> by_material;
-        for (size_t t = 0; t < data.indices.size() / 3; ++t) {
-            const int32_t m = object.material ? -1 : data.triangle_material[t];
-            by_material[m].push_back({data.indices[3 * t], data.indices[3 * t + 1], data.indices[3 * t + 2]});
-        }
-        for (const auto& [m, triangles] : by_material) {
-            const MaterialDescription* mtl = m >= 0 ? &data.materials[size_t(m)] : nullptr;
-            mesh(vertices, normals, triangles, to_world,
-                 mtl ? std::optional<Material>(to_material(*mtl)) : material_if_given(object));
-        }
-    }
-
-    /// A mesh2 in world space: vertices and normals transformed in double exactly as Whitted
-    /// does, written about the point Whitted stores the mesh about (mesh_origin, scene.h) as the
-    /// floats Whitted keeps, and moved there with `translate`: so the two renderers see the same
-    /// triangles. About its own centre a far mesh also keeps its precision in POV-Ray, which
-    /// holds each triangle's plane as a float normal and a float distance from the mesh's origin
-    /// (spaced 1e-3 at 1e4 in world coordinates: self-shadowing speckles); the ray is moved into
-    /// the mesh's frame in double.
-    void mesh(const std::vector<Vec3>& vertices, const std::vector<Vec3>& normals,
-              const std::vector<std::array<int64_t, 3>>& triangles, const Transform& to_world,
-              const std::optional<Material>& material) {
+    /// A mesh2 of Whitted's triangles: its vertices written as the float offsets Whitted stores
+    /// (world space, or the prototype's space, already transformed in double) and moved by
+    /// `translate` to the point they are stored about (mesh_origin, scene.h), so the two
+    /// renderers see the same triangles. About its own centre a far mesh also keeps its
+    /// precision in POV-Ray, which holds each triangle's plane as a float normal and a float
+    /// distance from the mesh's origin (spaced 1e-3 at 1e4 in world coordinates:
+    /// self-shadowing speckles); the ray is moved into the mesh's frame in double.
+    void mesh(const TriangleMesh& triangles, const Part& part) {
         // In a prototype (m_collect) the mesh2 goes to its piece, without a texture: each
         // instance gives its own.
         std::string piece;
         std::string& o = m_collect ? piece : m_out;
-        std::vector<Vec3> world;
-        world.reserve(vertices.size());
-        constexpr double inf = std::numeric_limits<double>::infinity();
-        Vec3 lo(inf), hi(-inf);
-        for (const Vec3& v : vertices) {
-            world.push_back(to_world.apply_point(v));
-            lo = min(lo, world.back()), hi = max(hi, world.back());
-        }
-        const Vec3 centre = mesh_origin(lo, hi);
-        for (Vec3& w : world) {
-            const Vec3 offset = w - centre;
-            w = {float_rounded(offset.x), float_rounded(offset.y), float_rounded(offset.z)};  // the stored floats
-        }
-        o += "mesh2 {\n  vertex_vectors { " + std::to_string(vertices.size());
-        for (const Vec3& w : world) o += ",\n    " + vec(w);
+        o += "mesh2 {\n  vertex_vectors { " + std::to_string(triangles.vertex_count());
+        for (size_t i = 0; i < triangles.vertex_count(); ++i) o += ",\n    " + vec(triangles.offset(i));
         o += " }\n";
-        if (!normals.empty()) {
-            o += "  normal_vectors { " + std::to_string(normals.size());
-            for (const Vec3& n : normals) {
-                const Vec3 w = to_world.apply_normal(n);
-                const double len = length(w);
-                const Vec3 unit = len > 0 ? w / len : Vec3(1, 0, 0);
-                o += ",\n    " + vec({float_rounded(unit.x), float_rounded(unit.y), float_rounded(unit.z)});
+        if (!triangles.normals.empty()) {
+            const size_t count = triangles.normals.size() / 3;
+            o += "  normal_vectors { " + std::to_string(count);
+            for (size_t i = 0; i < count; ++i) {
+                const float* n = &triangles.normals[3 * i];
+                // Whitted keeps a zero normal (shading then takes the face's); POV-Ray needs a
+                // direction, and any unit one serves where the face's normal is used.
+                const bool zero = n[0] == 0 && n[1] == 0 && n[2] == 0;
+                o += ",\n    " + vec(zero ? Vec3(1, 0, 0) : Vec3(n[0], n[1], n[2]));
             }
             o += " }\n";
         }
-        o += "  face_indices { " + std::to_string(triangles.size());
-        for (const auto& t : triangles)
+        o += "  face_indices { " + std::to_string(part.triangles.size());
+        for (const auto& t : part.triangles)
             o += ",\n    <" + std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " + std::to_string(t[2]) + ">";
         o += " }\n";
         // Any inside_vector makes POV-Ray's mesh2 report every crossing of a ray, not only its
@@ -376,18 +358,19 @@ private:
         // windows pick the same one (docs/pov-model.md §3). The vector itself only serves
         // POV-Ray's inside test, which nothing here uses.
         o += "  inside_vector <0, 0, 1>\n";
-        if (!m_collect) o += "  " + texture(*material) + "\n";  // validate_scene checked it is there
-        if (!(centre == Vec3(0.0))) o += "  translate " + vec(centre) + "\n";
+        // Outside a prototype every triangle has a material (validate_scene checked it).
+        if (!m_collect) o += "  " + texture(m_scene.materials[part.material]) + "\n";
+        if (!(triangles.origin == Vec3(0.0))) o += "  translate " + vec(triangles.origin) + "\n";
         o += "}\n";
-        if (m_collect) m_collect->push_back({std::move(piece), material});
+        if (m_collect) m_collect->push_back({std::move(piece), material_if_any(part.material)});
     }
 
-    const SceneDescription& m_description;
+    const Scene& m_scene;
     std::string& m_out;
-    std::map<std::string, Material> m_named;
+    std::vector<uint32_t> m_shape;             ///< per object (number − 1): its index in its kind's list
+    std::vector<Vec3> m_caps;                  ///< per cone or cylinder, as written
     std::vector<std::vector<Piece>> m_pieces;  ///< per prototype: its declared mesh2s
     std::vector<Piece>* m_collect = nullptr;   ///< the prototype being declared, or null
-    bool m_collect_shows_defaults = false;     ///< an instance without a material places it
 };
 
 double max_channel(const Color& c) {
@@ -432,11 +415,11 @@ double radiance_upper_bound(const SceneDescription& d) {
     return bound;
 }
 
-static std::string write_sdl(const SceneDescription& d, const ConvertOptions& options);
+static std::string write_sdl(const SceneDescription& d, const Scene& scene, const ConvertOptions& options);
 
-std::string scene_to_sdl(const SceneDescription& d, const ConvertOptions& options) {
+std::string scene_to_sdl(const SceneDescription& d, const Scene& scene, const ConvertOptions& options) {
     try {
-        return write_sdl(d, options);
+        return write_sdl(d, scene, options);
     } catch (const NotFinite& e) {
         throw InputError({d.path}, std::string("cannot convert to POV-Ray: a value becomes ") + e.what() +
                                        " once divided or transformed (ka/kd, 1/p, nested transforms); "
@@ -483,7 +466,7 @@ static void refuse_inexpressible(const SceneDescription& d) {
     for (const auto& prototype : d.prototypes) objects({prototype.object});
 }
 
-static std::string write_sdl(const SceneDescription& d, const ConvertOptions& options) {
+static std::string write_sdl(const SceneDescription& d, const Scene& scene, const ConvertOptions& options) {
     refuse_inexpressible(d);
     const double exposure = options.exposure;
     const double aspect = double(d.image.width.value) / double(d.image.height.value);
@@ -520,9 +503,10 @@ static std::string write_sdl(const SceneDescription& d, const ConvertOptions& op
     // light_group POV-Ray first re-tests the object that last blocked the same light, accepting
     // it from t = 1e-4 instead of the 1e-3 its full shadow test (and Whitted) uses, so a pixel's
     // shadow would depend on which pixel POV-Ray shaded before it (docs/pov-model.md §3).
-    SdlWriter writer(d, o);
+    SdlWriter writer(d, scene, o);
     writer.prototype_declarations();
-    const bool light_group = !d.lights.empty() && !d.objects.empty();
+    // (A description read with its objects streamed to the Scene holds none: the Scene's count.)
+    const bool light_group = !d.lights.empty() && (!d.objects.empty() || !scene.objects.empty());
     if (light_group) o += "light_group {\n";
     for (const auto& light : d.lights) {
         const Color intensity = light.intensity.value * exposure;
@@ -536,7 +520,7 @@ static std::string write_sdl(const SceneDescription& d, const ConvertOptions& op
                  rgb(intensity) + " parallel point_at <0, 0, 0> }\n";
         }
     }
-    writer.objects(d.objects, Transform());
+    writer.objects();
     if (light_group) o += "  global_lights off\n}\n";
     return o;
 }
@@ -571,7 +555,19 @@ void check_pov_file_name(const std::string& pov_path) {
                                         "quotes or backslashes; choose another name for the .pov file");
 }
 
+std::string scene_to_sdl(const SceneDescription& d, const ConvertOptions& options) {
+    refuse_inexpressible(d);  // before the mesh files are read, as `whitted convert` refuses
+    return scene_to_sdl(d, validate_scene(d), options);
+}
+
 std::string write_pov_files(const SceneDescription& d, const std::string& pov_path, const ConvertOptions& given) {
+    check_pov_file_name(pov_path);
+    refuse_inexpressible(d);
+    return write_pov_files(d, validate_scene(d), pov_path, given);
+}
+
+std::string write_pov_files(const SceneDescription& d, const Scene& scene, const std::string& pov_path,
+                            const ConvertOptions& given) {
     check_pov_file_name(pov_path);
     ConvertOptions options = given;
     if (!given.hdr_output && radiance_upper_bound(d) * options.exposure > 1.0) options.hdr_output = true;
@@ -580,7 +576,7 @@ std::string write_pov_files(const SceneDescription& d, const std::string& pov_pa
     ini.replace_extension(".ini");
     std::filesystem::path image = pov.filename();
     image.replace_extension(options.hdr_output ? ".exr" : ".png");
-    const std::string sdl = scene_to_sdl(d, options);
+    const std::string sdl = scene_to_sdl(d, scene, options);
     const std::string ini_text = ini_for(d, pov.filename().string(), image.string(), options);
     // Both files appear complete or not at all, even if the program is interrupted or killed.
     write_files_atomically({{pov, sdl}, {ini, ini_text}});

@@ -1,12 +1,19 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
-// Scene format v1 → POV-Ray 3.7 SDL that renders the same image (docs/pov-model.md). Reads the
-// plain SceneDescription, never the render objects, like any other consumer of the format.
+// Scene format v1 → POV-Ray 3.7 SDL that renders the same image (docs/pov-model.md). The
+// settings (camera, lights, image, render) come from the SceneDescription; the objects from the
+// Scene that validate_scene or load_scene_file built from it, whose one walk of the description
+// has folded the transforms, resolved the materials and read the mesh files: the SDL holds the
+// numbers Whitted renders, and no file is read again here.
 
 #include "whitted/scene/description.h"
 
 #include <string>
+
+namespace whitted {
+struct Scene;
+}
 
 namespace whitted::pov {
 
@@ -20,7 +27,10 @@ struct ConvertOptions {
     bool hdr_output = false;
 };
 
-/// The whole SDL scene.
+/// The whole SDL scene: `scene`'s settings and `built`'s objects (`built` is validate_scene(scene),
+/// or the Scene load_scene_file gave with `scene` as its settings).
+std::string scene_to_sdl(const SceneDescription& scene, const Scene& built, const ConvertOptions& options = {});
+/// Same, building the Scene first (validate_scene: the mesh files are read then).
 std::string scene_to_sdl(const SceneDescription& scene, const ConvertOptions& options = {});
 
 /// The .ini that renders it deterministically and linearly: +W +H -D -A +FN16 File_Gamma=1.0
@@ -39,7 +49,10 @@ double radiance_upper_bound(const SceneDescription& scene);
 void check_pov_file_name(const std::string& pov_path);
 
 /// Writes `pov_path` and the .ini beside it (same name, .ini). Returns the .ini path.
-/// Throws InputError for anything the description cannot express (mesh files are read here).
+/// Throws InputError for anything the description cannot express.
+std::string write_pov_files(const SceneDescription& scene, const Scene& built, const std::string& pov_path,
+                            const ConvertOptions& options = {});
+/// Same, building the Scene first (validate_scene: the mesh files are read then).
 std::string write_pov_files(const SceneDescription& scene, const std::string& pov_path,
                             const ConvertOptions& options = {});
 

@@ -248,7 +248,7 @@ CheckResult run_check(const SceneDescription& description, const std::string& sc
         pov::ConvertOptions convert;
         convert.exposure = exposure;
         convert.hdr_output = false;
-        const std::string sdl = pov::scene_to_sdl(description, convert);
+        const std::string sdl = pov::scene_to_sdl(description, scene, convert);
         const std::string ini = pov::ini_for(description, pov_name, povray_image_name, convert);
         write_files_atomically({{work / pov_name, sdl}, {work / ini_name, ini}});
         std::error_code ignored;

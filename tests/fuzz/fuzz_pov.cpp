@@ -137,14 +137,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const std::string text(reinterpret_cast<const char*>(data), size);
     const std::string path = (fuzz::scratch_directory() / "scene.yaml").string();
     SceneDescription description;
+    Scene scene;
     try {
         description = parse_scene_text(text, path);
-        validate_scene(description);  // `whitted convert` refuses what validation refuses
+        scene = validate_scene(description);  // `whitted convert` refuses what validation refuses
     } catch (const InputError&) {
         return 0;
     }
     try {
-        const std::string sdl = pov::scene_to_sdl(description);
+        const std::string sdl = pov::scene_to_sdl(description, scene);
         check_sdl(sdl);
         (void)pov::ini_for(description, "scene.pov", "scene.png");
         (void)pov::radiance_upper_bound(description);

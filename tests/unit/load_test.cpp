@@ -214,9 +214,10 @@ TEST(LoadScene, ReportsTheFirstMistakeInFileOrderWhereverTheMaterialsAre) {
     EXPECT_THAT(e->what(), ::testing::HasSubstr("image.width must be at least 1"));
 }
 
-TEST(LoadScene, StartsOverWhenTheFileIsReadAgainByLibyaml) {
+TEST(LoadScene, HandsEachObjectOnceWhenTheFileIsReadAgainByLibyaml) {
     // The anchor sends the file to libyaml (yaml_tree.h) after the fast scanner has handed over
-    // two objects: the one-pass reader must not keep them twice.
+    // two objects: the reader hands each object to its sink once, in order, and the one-pass
+    // reader keeps each once.
     const std::string text = scene_text({
         "materials:",
         "  grey: { kd: 0.5 }",
@@ -226,6 +227,15 @@ TEST(LoadScene, StartsOverWhenTheFileIsReadAgainByLibyaml) {
         "  - { type: sphere, center: &c [4, 0, 0], radius: 1, material: grey }",
         "  - { type: sphere, center: *c, radius: 2, material: grey }",
     });
+    std::vector<size_t> indices;
+    std::vector<double> radii;
+    const ObjectSink sink = [&](ObjectDescription&& object, size_t index) {
+        indices.push_back(index);
+        radii.push_back(object.radius.value);
+    };
+    (void)parse_scene_text(text, "anchors.yaml", &sink);
+    EXPECT_THAT(indices, testing::ElementsAre(0u, 1u, 2u, 3u));
+    EXPECT_THAT(radii, testing::ElementsAre(1.0, 1.0, 1.0, 2.0));
     const Scene scene = load_scene_text(text, "anchors.yaml");
     EXPECT_EQ(scene.spheres.size(), 4u);
     EXPECT_EQ(scene.objects.size(), 4u);

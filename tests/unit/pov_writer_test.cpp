@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 
 namespace whitted {
 namespace {
@@ -61,8 +62,8 @@ std::string sdl_for(const std::string& objects_and_materials, const std::string&
         parse_scene_text("camera: {eye: [0, 1, 5], look_at: [0, 0, 0], fov: 50}\nimage: {width: 40, height: 30}\n" +
                              objects_and_materials,
                          path);
-    (void)validate_scene(d);  // the converter's input is always a valid scene
-    return pov::scene_to_sdl(d);
+    const Scene scene = validate_scene(d);  // the converter's input is always a valid scene
+    return pov::scene_to_sdl(d, scene);
 }
 
 // Lights and objects sit in one light_group, after the camera: POV-Ray keeps no shadow cache
@@ -349,6 +350,40 @@ TEST(PovWriter, MeshWithItsOwnMaterialIgnoresTheObjMaterialsAsRenderDoes) {
     EXPECT_THAT(printed, Not(HasSubstr("warning")));
     EXPECT_EQ(count_of(sdl, "mesh2"), 1u);
     EXPECT_EQ(numbers_after(sdl, "pigment { rgb", 3), (std::vector<double>{0.25, 0.5, 0.75}));
+}
+
+// The converter writes the Scene validate_scene built: the mesh files were read once, by that
+// walk, and are not read again (here they are gone by the time the SDL is written), and an OBJ
+// with two MTL materials becomes one mesh2 per material, in the MTL's order.
+TEST(PovWriter, WritesTheBuiltSceneWithoutReadingTheMeshFilesAgain) {
+    const test::ScratchDirectory dir;
+    dir.write("two.mtl", "newmtl red\nKa 0 0 0\nKd 1 0 0\nKs 0 0 0\nnewmtl green\nKa 0 0 0\nKd 0 1 0\nKs 0 0 0\n");
+    dir.write("quad.obj",
+              "mtllib two.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl green\nf 1 2 3\nusemtl red\nf 1 3 4\n");
+    const std::string path = (dir.path() / "scene.yaml").string();
+    const SceneDescription d = parse_scene_text(
+        "camera: {eye: [0, 1, 5], look_at: [0, 0, 0]}\nimage: {width: 4, height: 3}\n"
+        "objects:\n  - {type: mesh, file: quad.obj, transform: [{translate: [0, 0, 1]}]}\n",
+        path);
+    const Scene scene = validate_scene(d);
+    const std::string before = pov::scene_to_sdl(d, scene);
+    std::filesystem::remove(dir.path() / "quad.obj");
+    std::filesystem::remove(dir.path() / "two.mtl");
+    EXPECT_EQ(pov::scene_to_sdl(d, scene), before);
+    EXPECT_EQ(count_of(before, "mesh2"), 2u);
+    const size_t red = before.find("pigment { rgb <1, 0, 0> }"), green = before.find("pigment { rgb <0, 1, 0> }");
+    ASSERT_NE(red, std::string::npos);
+    ASSERT_NE(green, std::string::npos);
+    EXPECT_LT(red, green);  // red is the MTL's first material
+    EXPECT_EQ(numbers_after(before, "face_indices { 1,\n    <", 3), (std::vector<double>{0, 2, 3}));
+}
+
+// A cone's cap is written as the scene gives it, not as base + height·axis (which rounds).
+TEST(PovWriter, ConeCapIsWrittenAsGiven) {
+    const std::string sdl = sdl_for(
+        "objects:\n  - {type: cone, base: [0.1, 0.2, 0.3], base_radius: 0.7, cap: [0.3, 1.7, -0.9],"
+        " cap_radius: 0.1, material: {kd: 0.5}}\n");
+    EXPECT_EQ(numbers_after(sdl, "cone {", 8), (std::vector<double>{0.1, 0.2, 0.3, 0.7, 0.3, 1.7, -0.9, 0.1}));
 }
 
 // A prototype's OBJ without usemtl: its faces get the default material only through an

@@ -233,8 +233,8 @@ inline constexpr int64_t max_yaml_nodes = 10'000'000;
 }  // namespace limits
 
 /// Receives each top-level object as soon as it is parsed, with its index in `objects`, so that a
-/// reader can use it and let it go (load_scene_file). If the reader has to start again (a file the
-/// fast scanner hands to libyaml, yaml_tree.h), index 0 comes again: start over.
+/// reader can use it and let it go (load_scene_file). Each index comes once, in order, whichever
+/// way the reader read the text.
 using ObjectSink = std::function<void(ObjectDescription&&, size_t index)>;
 
 /// Reads a scene file (YAML or JSON; a `.xml` file is read as a Cornell CS4620 course scene,

@@ -792,20 +792,12 @@ namespace {
 template <class Parse>
 Scene load_scene(const Parse& parse, SceneDescription* settings, const SettingOverrides& overrides) {
     Scene scene;
-    auto builder = std::make_unique<SceneBuilder>(scene);
-    bool started = false;
-    const ObjectSink sink = [&](ObjectDescription&& object, size_t index) {
-        if (index == 0 && started) {  // read again from the start (description.h)
-            scene = Scene();
-            builder = std::make_unique<SceneBuilder>(scene);
-        }
-        started = true;
-        builder->add_top_level(object);
-    };
+    SceneBuilder builder(scene);
+    const ObjectSink sink = [&](ObjectDescription&& object, size_t) { builder.add_top_level(object); };
     SceneDescription d = parse(&sink);
     apply_overrides(overrides, d);
     validate_settings(d, scene);
-    builder->finish(d);
+    builder.finish(d);
     check_triangle_limit(scene);
     if (settings) *settings = std::move(d);
     return scene;

@@ -125,6 +125,8 @@ class Document {
 public:
     /// Called with each item of the top-level `objects` list (and its index) as soon as it is
     /// complete; the item is forgotten afterwards. An exception thrown here ends the reading.
+    /// Where the fast scanner leaves the text to libyaml, libyaml reads it from the start and the
+    /// items come again from index 0 (parse.cpp hands each to its caller once).
     using ObjectCallback = std::function<void(Node item, size_t index)>;
 
     /// Reads `text` (already checked to be UTF-8 without NUL bytes). Throws InputError with the
