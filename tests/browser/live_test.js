@@ -110,6 +110,7 @@ async function settled(page, timeout) {
     await page.waitForFunction(() => whittedLive.shownView === "beauty" && document.body.dataset.live === "ready",
                                null, {timeout: 60000});
     check((await shownPng(page)).equals(after), "back to the beauty: the same image as before");
+    check(!(await page.locator("#explain").evaluate((e) => e.classList.contains("stale"))), "a change of view leaves the explanation as it is (same values)");
 
     // 2c. Save as a new file; a second save to it is refused unless the user confirms.
     await page.fill("#save-path", "saved.yaml");
@@ -174,6 +175,7 @@ async function settled(page, timeout) {
     await settled(page, 60000);
     check(await page.locator("#image").isVisible(), "the image is back once the file loads again");
     check((await shownPng(page)).equals(before), "and it is the file's own image again");
+    check((await page.locator("#explain").evaluate((e) => e.classList.contains("stale"))), "the explanation of the edited values is dimmed now");
 
     // The server's two refusals of the save over the existing file (409, before the page asked)
     // are logged by Chromium as failed loads: expected, and only those.
