@@ -344,7 +344,23 @@ void name_non_finite_numbers(nlohmann::json& j) {
     }
 }
 
+/// The explanation as JSON text. Names may be Latin-1 (MTL files): bytes that are not UTF-8 are
+/// written as U+FFFD, so that the output is JSON whatever the scene holds.
+std::string json_text(const Scene& scene, const std::string& path, const PixelExplanation& explanation) {
+    nlohmann::json document = to_json(scene, path, explanation);
+    name_non_finite_numbers(document);
+    return document.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 }  // namespace
+
+std::string explain_pixel_json(const Scene& scene, const std::string& scene_path, int x, int y, int threads) {
+    if (x < 0 || y < 0 || x >= scene.width || y >= scene.height)
+        throw std::invalid_argument(fmt::format("pixel {},{} is outside the {}x{} image (X 0..{}, Y 0..{})", x, y,
+                                                scene.width, scene.height, scene.width - 1, scene.height - 1));
+    const Accelerator accelerator(scene, threads);
+    return json_text(scene, scene_path, explain_pixel(scene, accelerator, x, y));
+}
 
 int run_explain(const std::string& scene_path, const std::string& pixel, bool json, bool summary, int threads) {
     Scene scene;
@@ -362,11 +378,7 @@ int run_explain(const std::string& scene_path, const std::string& pixel, bool js
         const Accelerator accelerator(scene, threads);
         const PixelExplanation explanation = explain_pixel(scene, accelerator, x, y);
         if (json) {
-            // Names may be Latin-1 (MTL files): bytes that are not UTF-8 are written as U+FFFD, so
-            // that the output is JSON whatever the scene holds.
-            nlohmann::json document = to_json(scene, scene_path, explanation);
-            name_non_finite_numbers(document);
-            std::printf("%s\n", document.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+            std::printf("%s\n", json_text(scene, scene_path, explanation).c_str());
         } else if (summary)
             print_summary(scene, scene_path, explanation);
         else

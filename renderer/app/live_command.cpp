@@ -9,6 +9,8 @@
 
 #include "api/api_internal.h"
 #include "api/errors.h"
+#include "converters/yaml_writer.h"
+#include "explain_command.h"
 #include "live_page_html.h"
 #include "whitted/scene/description.h"
 #include "whitted/scene/scene.h"
@@ -33,6 +35,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
@@ -247,19 +250,46 @@ private:
     uint64_t m_version = 0;
 };
 
+/// The file's text with the page's values written over it, as a description.
+SceneDescription edited_description(const std::string& text, const std::string& path, const json& values) {
+    SceneDescription description = parse_any_scene_text(text, path);
+    apply_page_values(description, values);
+    return description;
+}
+
+/// The colour render layers the page can show instead of the beauty (docs/layers.md): each is
+/// an RGB image; light<k> (1-based) comes from the `lights` layer.
+const char* const colour_layers[] = {"ambient", "diffuse", "specular", "mirror", "transmission", "background"};
+
+/// The layer to ask the render for to show `view` ("beauty": none), or BadRequest.
+std::string layer_for_view(const std::string& view, size_t light_count) {
+    if (view == "beauty") return "none";
+    for (const char* layer : colour_layers)
+        if (view == layer) return view;
+    if (view.size() > 5 && view.compare(0, 5, "light") == 0 && view[5] != '0' &&
+        view.find_first_not_of("0123456789", 5) == std::string::npos && view.size() < 10) {
+        const long k = std::stol(view.substr(5));
+        if (k >= 1 && size_t(k) <= light_count) return "lights";
+    }
+    throw BadRequest("view '" + view + "': expected beauty, ambient, diffuse, specular, mirror, transmission, " +
+                     "background or light1.." + "light" + std::to_string(light_count));
+}
+
 /// The render at `level` "coarse" (a quarter of the width and height, one sample per pixel: the
 /// first image while the slider moves) or "full" (the scene's own settings), as PNG through the
-/// default display transform (as `whitted render -o x.png`) or linear EXR (as `-o x.exr`).
+/// default display transform (as `whitted render -o x.png`) or linear EXR (as `-o x.exr`). A
+/// `view` other than "beauty" is that render layer, rendered as `whitted render --layers` does,
+/// written as the image's R, G, B.
 struct Rendered {
     std::string bytes;
     double render_seconds = 0;
 };
 
-Rendered render_image(const std::string& text, const std::string& path, const json& values, bool coarse, int threads,
+Rendered render_image(SceneDescription description, const std::string& view, bool coarse, int threads,
                       const std::filesystem::path& temp_file) {
     auto impl = std::make_unique<api::Scene::Impl>();
-    impl->description = parse_any_scene_text(text, path);
-    apply_page_values(impl->description, values);
+    impl->description = std::move(description);
+    const std::string layer = layer_for_view(view, impl->description.lights.size());
     if (coarse) {
         ImageDescription& image = impl->description.image;
         image.width.value = std::max<int64_t>(1, image.width.value / 4);
@@ -270,10 +300,22 @@ Rendered render_image(const std::string& text, const std::string& path, const js
     const api::Scene scene(std::move(impl));
     api::RenderOptions options;
     options.threads = threads;
-    options.layers = {"none"};  // the beauty only: the page shows it, and a PNG has no layers
+    options.layers = {layer};  // the beauty alone renders with none, as `whitted render` without layers
     api::Expected<api::RenderResult> result = api::render(scene, options);
     if (!result) throw std::runtime_error(result.error().what());
-    if (const auto written = api::write_image(result->image, temp_file.string(), {}); !written)
+    Image shown;
+    if (view == "beauty") {
+        shown = std::move(result->image);
+        shown.layers.clear();
+    } else {
+        shown.width = result->image.width;
+        shown.height = result->image.height;
+        for (ImageLayer& l : result->image.layers)
+            if (l.channels.size() == 3 && l.channels[0] == view + ".R") shown.rgb = std::move(l.values);
+        if (shown.rgb.size() != size_t(shown.width) * size_t(shown.height) * 3)
+            throw std::runtime_error("the render has no layer " + view);
+    }
+    if (const auto written = api::write_image(shown, temp_file.string(), {}); !written)
         throw std::runtime_error(written.error().what());
     Rendered rendered;
     {
@@ -286,6 +328,18 @@ Rendered render_image(const std::string& text, const std::string& path, const js
     std::filesystem::remove(temp_file, ignored);
     rendered.render_seconds = result->stats.seconds;
     return rendered;
+}
+
+/// Where the page asks to save: a .yaml or .yml path, relative ones beside the scene file.
+std::filesystem::path save_target(const json& body, const std::string& scene_path) {
+    const std::string text = string_member(body, "path", "");
+    if (text.empty()) throw BadRequest("path: expected the name of the file to write (a .yaml or .yml file)");
+    std::filesystem::path target(text);
+    if (target.is_relative()) target = std::filesystem::path(scene_path).parent_path() / target;
+    const std::string ext = target.extension().string();
+    if (ext != ".yaml" && ext != ".yml")
+        throw BadRequest("path '" + text + "': the scene is saved in Whitted's own format, a .yaml or .yml file");
+    return target.lexically_normal();
 }
 
 void send_error(httplib::Response& response, int status, const std::string& message) {
@@ -392,42 +446,150 @@ int run_live(const LiveArguments& args) {
             send_error(response, 422, e.what());
         }
     });
-    // One render at a time: two at once would only share the two cores and both be late.
+    // One render (or explain, or check) at a time: two at once would only share the two cores
+    // and both be late.
     std::mutex render_mutex;
-    uint64_t render_count = 0;
-    server.Post("/render", [&](const httplib::Request& request, httplib::Response& response) {
-        json body;
-        try {
-            body = json::parse(request.body);
-        } catch (const std::exception& e) {
-            return send_error(response, 400, std::string("the request is not JSON: ") + e.what());
-        }
-        if (!body.is_object()) return send_error(response, 400, "the request must be a JSON object");
+    uint64_t render_count = 0, check_count = 0;
+    // A POST whose body is a JSON object about the file as it loads now, with its errors sent
+    // as 400 (the page's request), 422 (the scene refuses the values), 409 (the file does not
+    // load) or 500.
+    using Handler = std::function<void(const json&, const LiveState::Snapshot&, httplib::Response&)>;
+    const auto post = [&](const std::string& route, const Handler& handler) {
+        server.Post(route, [&, handler, route](const httplib::Request& request, httplib::Response& response) {
+            json body;
+            try {
+                body = json::parse(request.body);
+            } catch (const std::exception& e) {
+                return send_error(response, 400, std::string("the request is not JSON: ") + e.what());
+            }
+            if (!body.is_object()) return send_error(response, 400, "the request must be a JSON object");
+            const LiveState::Snapshot snapshot = state.snapshot();
+            if (!snapshot.error.empty()) return send_error(response, 409, snapshot.error);
+            response.set_header("Cache-Control", "no-store");
+            try {
+                handler(body, snapshot, response);
+            } catch (const BadRequest& e) {
+                send_error(response, 400, e.what());
+            } catch (...) {
+                // Bad input is a page value the scene format refuses, at its place in the file.
+                const api::Error error = api::current_error({"serving " + route + " for " + state.path()});
+                send_error(response, error.kind == api::Error::Kind::bad_input ? 422 : 500, error.what());
+            }
+        });
+    };
+    const auto values_of = [](const json& body) { return body.value("values", json::object()); };
+
+    post("/render", [&](const json& body, const LiveState::Snapshot& snapshot, httplib::Response& response) {
         const std::string level = string_member(body, "level", "full"), format = string_member(body, "format", "png");
         if ((level != "full" && level != "coarse") || (format != "png" && format != "exr"))
-            return send_error(response, 400, "level must be full or coarse, format png or exr");
-        const LiveState::Snapshot snapshot = state.snapshot();
-        if (!snapshot.error.empty()) return send_error(response, 409, snapshot.error);
-        try {
-            std::lock_guard lock(render_mutex);
-            const std::filesystem::path file = temp_dir / ("render-" + std::to_string(++render_count) + "." + format);
-            const auto start = std::chrono::steady_clock::now();
-            const Rendered rendered = render_image(snapshot.text, state.path(), body.value("values", json::object()),
-                                                   level == "coarse", args.threads, file);
-            const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-            response.set_header("X-Whitted-Version", std::to_string(snapshot.version));
-            response.set_header("X-Whitted-Render-Ms", std::to_string(int(rendered.render_seconds * 1000 + 0.5)));
-            response.set_header("X-Whitted-Total-Ms", std::to_string(int(seconds * 1000 + 0.5)));
-            response.set_header("Cache-Control", "no-store");
-            response.set_content(rendered.bytes, format == "exr" ? "image/x-exr" : "image/png");
-        } catch (const BadRequest& e) {
-            send_error(response, 400, e.what());
-        } catch (...) {
-            // Bad input is a page value the scene format refuses, at its place in the file.
-            const api::Error error = api::current_error({"rendering " + state.path()});
-            send_error(response, error.kind == api::Error::Kind::bad_input ? 422 : 500, error.what());
-        }
+            throw BadRequest("level must be full or coarse, format png or exr");
+        const std::string view = string_member(body, "view", "beauty");
+        std::lock_guard lock(render_mutex);
+        const std::filesystem::path file = temp_dir / ("render-" + std::to_string(++render_count) + "." + format);
+        const auto start = std::chrono::steady_clock::now();
+        const Rendered rendered = render_image(edited_description(snapshot.text, state.path(), values_of(body)), view,
+                                               level == "coarse", args.threads, file);
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        response.set_header("X-Whitted-Version", std::to_string(snapshot.version));
+        response.set_header("X-Whitted-Render-Ms", std::to_string(int(rendered.render_seconds * 1000 + 0.5)));
+        response.set_header("X-Whitted-Total-Ms", std::to_string(int(seconds * 1000 + 0.5)));
+        response.set_content(rendered.bytes, format == "exr" ? "image/x-exr" : "image/png");
     });
+
+    // `whitted explain --json` of one pixel of the edited scene.
+    post("/explain", [&](const json& body, const LiveState::Snapshot& snapshot, httplib::Response& response) {
+        const auto coordinate = [&](const char* key) {
+            const auto member = body.find(key);
+            if (member == body.end() || !member->is_number_integer())
+                throw BadRequest(std::string(key) + ": expected the pixel's whole-number column (x) and row (y)");
+            return member->get<int64_t>();
+        };
+        const int64_t x = coordinate("x"), y = coordinate("y");
+        const SceneDescription description = edited_description(snapshot.text, state.path(), values_of(body));
+        const Scene scene = validate_scene(description);
+        if (x < 0 || y < 0 || x >= scene.width || y >= scene.height)
+            throw BadRequest("pixel " + std::to_string(x) + "," + std::to_string(y) + " is outside the " +
+                             std::to_string(scene.width) + "x" + std::to_string(scene.height) + " image");
+        std::lock_guard lock(render_mutex);
+        response.set_content(explain_pixel_json(scene, state.path(), int(x), int(y), args.threads), "application/json");
+    });
+
+    // The edited scene written to a new file, in Whitted's own format; an existing file only
+    // with the page's explicit "overwrite": true (the page asks the user first).
+    post("/save", [&](const json& body, const LiveState::Snapshot& snapshot, httplib::Response& response) {
+        const std::filesystem::path target = save_target(body, state.path());
+        const auto overwrite = body.find("overwrite");
+        if (overwrite != body.end() && !overwrite->is_boolean()) throw BadRequest("overwrite: expected true or false");
+        const SceneDescription description = edited_description(snapshot.text, state.path(), values_of(body));
+        (void)validate_scene(description);  // only a scene that renders is written
+        std::error_code error;
+        const std::filesystem::file_status status = std::filesystem::symlink_status(target, error);
+        if (std::filesystem::exists(status)) {
+            if (!std::filesystem::is_regular_file(status))
+                throw BadRequest("'" + target.string() + "' exists and is not a plain file: not written");
+            if (overwrite == body.end() || !overwrite->get<bool>()) {
+                response.status = 409;
+                response.set_content(
+                    json{{"error", "'" + target.string() + "' exists: not written (send overwrite to replace it)"},
+                         {"exists", true},
+                         {"path", target.string()}}
+                        .dump(),
+                    "application/json");
+                return;
+            }
+        }
+        if (!std::filesystem::is_directory(target.parent_path(), error))
+            throw BadRequest("'" + target.parent_path().string() + "' is not a directory: not written");
+        yaml::write_yaml_file(description, target.string());
+        response.set_content(json{{"path", target.string()}, {"written", true}}.dump(), "application/json");
+    });
+
+    // `whitted check` of the edited scene: written as YAML into the temporary directory, checked
+    // against POV-Ray with a report, whose ours.png and povray.png the page wipes between.
+    post("/check", [&](const json& body, const LiveState::Snapshot& snapshot, httplib::Response& response) {
+        const SceneDescription description = edited_description(snapshot.text, state.path(), values_of(body));
+        (void)validate_scene(description);
+        std::lock_guard lock(render_mutex);
+        const uint64_t number = ++check_count;
+        std::error_code ignored;
+        if (number > 1) std::filesystem::remove_all(temp_dir / ("check-" + std::to_string(number - 1)), ignored);
+        const std::filesystem::path dir = temp_dir / ("check-" + std::to_string(number));
+        std::filesystem::create_directories(dir);
+        const std::string file = (dir / std::filesystem::path(state.path()).filename()).replace_extension(".yaml");
+        yaml::write_yaml_file(description, file);
+        api::CheckOptions options;
+        options.threads = args.threads;
+        options.report_dir = (dir / "report").string();
+        const api::Expected<api::CheckResult> result = api::check(file, options);
+        if (!result) throw std::runtime_error(result.error().what());
+        // The verdict names the file checked: the edited scene, not its temporary copy.
+        std::string verdict = result->verdict;
+        if (const size_t at = verdict.find(file); at != std::string::npos)
+            verdict.replace(at, file.size(), std::filesystem::path(state.path()).filename().string() + " (edited)");
+        const std::string images = "/check/" + std::to_string(number) + "/";
+        response.set_content(json{{"passed", result->passed},
+                                  {"fraction_within", result->fraction_within},
+                                  {"max_error_codes", result->max_error_codes},
+                                  {"psnr", result->psnr},
+                                  {"failures", result->failures},
+                                  {"verdict", verdict},
+                                  {"ours", images + "ours.png"},
+                                  {"povray", images + "povray.png"},
+                                  {"diff", images + "diff.png"}}
+                                 .dump(),
+                             "application/json");
+    });
+    server.Get(R"(/check/(\d{1,18})/(ours|povray|diff)\.png)",
+               [&](const httplib::Request& request, httplib::Response& response) {
+                   const std::filesystem::path file = temp_dir / ("check-" + request.matches[1].str()) / "report" /
+                                                      (request.matches[2].str() + ".png");
+                   std::ifstream in(file, std::ios::binary);
+                   if (!in) return send_error(response, 404, "no such check image (a newer check replaced it?)");
+                   std::ostringstream bytes;
+                   bytes << in.rdbuf();
+                   response.set_header("Cache-Control", "no-store");
+                   response.set_content(bytes.str(), "image/png");
+               });
 
     std::atomic<bool> done{false};
     std::atomic<int> stop_signal{0};

@@ -5,10 +5,14 @@
 Starts `whitted live` on a copy of a lecture scene, checks that a foreign Origin and a foreign
 Host get 403 (and the same request without them 200), then live_test.js opens the page in
 Debian's Chromium, moves a material slider and saves the values the page sent and the PNG it
-shows, writes a bad edit to the file and saves the error the page shows. Here, without the
-page: the server's EXR of those values and the page's PNG must equal `whitted render` of the
-scene with the values written into the file, pixel for pixel (read with OpenImageIO); the
-page's error must be the message `whitted render` prints for the bad file; SIGTERM exits 143.
+shows, clicks a pixel (explain), shows the diffuse layer, saves the edited scene as saved.yaml,
+runs the check against POV-Ray, writes a bad edit to the file and saves the error the page
+shows. Here, without the page: the server's EXR of those values and the page's PNG must equal
+`whitted render` of the scene with the values written into the file, pixel for pixel (read with
+OpenImageIO), and so must the render of saved.yaml; the page's explain must be `whitted explain
+--json`'s numbers, its diffuse layer `whitted render --layers diffuse`'s, its verdict `whitted
+check`'s, all of saved.yaml; saving over a file without "overwrite" is refused; the page's error
+must be the message `whitted render` prints for the bad file; SIGTERM exits 143.
 
 usage: live_browser.py WHITTED SOURCE_DIR WORK_DIR TOOLS_DIR
 """
@@ -61,6 +65,18 @@ def status(port, headers):
     return code
 
 
+def post(port, route, body, headers=None):
+    """POST a JSON body to the server (as our own page, unless `headers` says otherwise)."""
+    connection = http.client.HTTPConnection("127.0.0.1", port, timeout=180)
+    connection.request("POST", route, body=json.dumps(body),
+                       headers=dict({"Content-Type": "application/json", "Origin": f"http://127.0.0.1:{port}"},
+                                    **(headers or {})))
+    response = connection.getresponse()
+    code, data = response.status, response.read()
+    connection.close()
+    return code, data
+
+
 def main():
     whitted, source, work, tools = sys.argv[1:5]
     missing = []
@@ -107,13 +123,25 @@ def main():
             fail("the page did not do what it should (above)")
         values = json.load(open(os.path.join(work, "values.json")))
 
-        # The server's linear image of the same values, as EXR.
-        request = urllib.request.Request(address + "render", method="POST",
-                                         data=json.dumps({"level": "full", "format": "exr",
-                                                          "values": values}).encode(),
-                                         headers={"Content-Type": "application/json"})
-        with urllib.request.urlopen(request, timeout=120) as response:
-            open(os.path.join(work, "served.exr"), "wb").write(response.read())
+        # The server's linear image of the same values, as EXR; its diffuse layer, as EXR and PNG.
+        for name, body in (("served.exr", {"format": "exr"}), ("served-diffuse.exr", {"format": "exr", "view": "diffuse"}),
+                           ("served-diffuse.png", {"format": "png", "view": "diffuse"})):
+            code, data = post(port, "/render", dict(body, level="full", values=values))
+            check(code == 200, f"POST /render {body}: {code}")
+            open(os.path.join(work, name), "wb").write(data)
+
+        # Saving over an existing file without the page's "overwrite" is refused; so is a
+        # save from another origin, and a file that is not YAML.
+        saved = os.path.join(work, "saved.yaml")
+        saved_text = open(saved).read()
+        code, data = post(port, "/save", {"path": "saved.yaml", "values": values})
+        check(code == 409 and open(saved).read() == saved_text,
+              f"POST /save over saved.yaml without overwrite: {code} {data[:120]!r}, the file unchanged")
+        code, _ = post(port, "/save", {"path": "foreign.yaml", "values": values}, {"Origin": "http://evil.example"})
+        check(code == 403 and not os.path.exists(os.path.join(work, "foreign.yaml")),
+              f"POST /save from Origin http://evil.example: {code}, nothing written")
+        code, _ = post(port, "/save", {"path": "saved.txt", "values": values})
+        check(code == 400 and not os.path.exists(os.path.join(work, "saved.txt")), f"POST /save saved.txt: {code}")
     finally:
         server.send_signal(signal.SIGTERM)
         code = server.wait(timeout=30)
@@ -144,6 +172,57 @@ def main():
           f"the page's PNG {page_png.shape} equals `whitted render -o edited.png` pixel for pixel")
     check(not np.array_equal(page_png, pixels(os.path.join(work, "original.png"))),
           "and differs from the render of the unedited file (the comparison can fail)")
+
+    # The saved file renders to the image the page showed: whitted render, bit for bit.
+    saved = os.path.join(work, "saved.yaml")
+    # (The page's PNG is the edited file's, above: the same EXR gives the same PNG.)
+    r = subprocess.run([whitted, "render", saved, "-q", "-o", os.path.join(work, "saved.exr")])
+    check(r.returncode == 0, f"whitted render saved.yaml -o saved.exr: exit {r.returncode}")
+    check(np.array_equal(pixels(os.path.join(work, "saved.exr")), served),
+          "the saved file's EXR equals the served EXR of the page's values bit for bit")
+
+    # explain of the clicked pixel: the numbers `whitted explain --json` gives for the saved file
+    # (its places in the file, `where`, and its name differ: the saved file is another file).
+    explained = json.load(open(os.path.join(work, "explain.json")))
+    check(explained["values"] == values, "the page explained the saved values")
+    r = subprocess.run([whitted, "explain", saved, "--pixel", f"{explained['x']},{explained['y']}", "--json"],
+                       capture_output=True, text=True)
+    check(r.returncode == 0, f"whitted explain saved.yaml: exit {r.returncode} {r.stderr}")
+
+    def numbers(document):
+        if isinstance(document, dict):
+            return {k: numbers(v) for k, v in document.items() if k not in ("scene", "where")}
+        if isinstance(document, list):
+            return [numbers(v) for v in document]
+        return document
+
+    page_terms, cli_terms = numbers(explained["result"]), numbers(json.loads(r.stdout))
+    check(page_terms == cli_terms and cli_terms["samples"][0]["segments"][0]["hit"],
+          f"the page's explain of pixel ({explained['x']}, {explained['y']}) equals `whitted explain --json` "
+          f"(ambient {cli_terms['layers']['ambient']}, light 1 {cli_terms['layers']['lights'][0]})")
+
+    # The diffuse layer the page showed: `whitted render --layers diffuse`'s channels, bit for bit.
+    r = subprocess.run([whitted, "render", saved, "-q", "--layers", "diffuse", "-o", os.path.join(work, "layers.exr")])
+    check(r.returncode == 0, f"whitted render --layers diffuse: exit {r.returncode}")
+    layers = oiio.ImageInput.open(os.path.join(work, "layers.exr"))
+    names = list(layers.spec().channelnames)
+    first = names.index("diffuse.R")
+    diffuse = np.asarray(layers.read_image(0, 0, first, first + 3, oiio.FLOAT))
+    layers.close()
+    served_diffuse = pixels(os.path.join(work, "served-diffuse.exr"))
+    check(names[first:first + 3] == ["diffuse.R", "diffuse.G", "diffuse.B"] and np.array_equal(served_diffuse, diffuse),
+          "the served diffuse layer equals `whitted render --layers diffuse`'s diffuse.R/G/B bit for bit")
+    check(np.array_equal(pixels(os.path.join(work, "page-diffuse.png")), pixels(os.path.join(work, "served-diffuse.png"))),
+          "the page showed the server's PNG of that layer")
+
+    # check: the verdict the page showed is `whitted check`'s for the saved file.
+    checked = json.load(open(os.path.join(work, "check.json")))["result"]
+    r = subprocess.run([whitted, "check", saved, "-q"], capture_output=True, text=True)
+    verdict = r.stdout.strip().splitlines()[-1] if r.stdout.strip() else ""
+    expected_figures = verdict.split(": ", 1)[-1]
+    check(r.returncode in (0, 1) and verdict.startswith("PASS" if checked["passed"] else "FAIL")
+          and checked["verdict"].split(": ", 1)[-1] == expected_figures and (r.returncode == 0) == checked["passed"],
+          f"the page's verdict {checked['verdict']!r} is `whitted check`'s {verdict!r}")
 
     # The error the page showed is the one `whitted render` gives for the same file.
     shown = open(os.path.join(work, "page-error.txt")).read()

@@ -4,6 +4,8 @@
 // the full image of the new value, saves what the page sent and shows (live_browser.py compares
 // it with `whitted render` of the edited file), then writes a bad edit to the scene file and
 // saves the error the page shows, then restores the file and waits for the image to come back.
+// Between these it clicks a pixel (explain), shows the diffuse layer, saves the edited scene (and
+// declines, then confirms, overwriting it) and runs the check against POV-Ray.
 // usage: node live_test.js URL SCENE WORK_DIR SCREENSHOT_DIR CHROMIUM
 "use strict";
 const fs = require("fs");
@@ -83,6 +85,79 @@ async function settled(page, timeout) {
     fs.writeFileSync(path.join(work, "timings.json"), JSON.stringify(timings));
     await page.screenshot({path: path.join(shots, "live.png")});
 
+    // 2a. explain: a click on a pixel of the highlight shows its terms (live_browser.py compares
+    // them with `whitted explain --json` of the saved file).
+    const [px, py] = [280, 200];
+    await page.locator("#image").click({position: {x: px + 0.5, y: py + 0.5}});
+    await page.waitForFunction(([x, y]) => whittedLive.explained && whittedLive.explained.x === x &&
+                                           whittedLive.explained.y === y, [px, py], {timeout: 30000});
+    const explained = await page.evaluate(() => whittedLive.explained);
+    check(JSON.stringify(explained.values) === JSON.stringify(values), "explain used the values of the image shown");
+    const explainText = await page.locator("#explain").textContent();
+    const ambient = explained.result.layers.ambient.map((v) => String(+v.toPrecision(6))).join(", ");
+    check(explainText.includes(`(${px}, ${py})`) && explainText.includes(ambient) && explainText.includes("light 1"),
+          `the explain panel shows pixel (${px}, ${py}), its ambient ${ambient} and light 1`);
+    fs.writeFileSync(path.join(work, "explain.json"), JSON.stringify(explained));
+
+    // 2b. A render layer as the view: diffuse, then back to the beauty.
+    await page.selectOption("#layer", "diffuse");
+    await page.waitForFunction(() => whittedLive.shownView === "diffuse" && document.body.dataset.live === "ready",
+                               null, {timeout: 60000});
+    const diffuse = await shownPng(page);
+    check(!diffuse.equals(after), "the diffuse layer's image differs from the beauty");
+    fs.writeFileSync(path.join(work, "page-diffuse.png"), diffuse);
+    await page.selectOption("#layer", "beauty");
+    await page.waitForFunction(() => whittedLive.shownView === "beauty" && document.body.dataset.live === "ready",
+                               null, {timeout: 60000});
+    check((await shownPng(page)).equals(after), "back to the beauty: the same image as before");
+    check(!(await page.locator("#explain").evaluate((e) => e.classList.contains("stale"))), "a change of view leaves the explanation as it is (same values)");
+
+    // 2c. Save as a new file; a second save to it is refused unless the user confirms.
+    await page.fill("#save-path", "saved.yaml");
+    const savedPath = path.join(path.dirname(scenePath), "saved.yaml");
+    const saved = () => page.evaluate(() => whittedLive.saved);
+    await page.click("#save");
+    await page.waitForFunction(() => whittedLive.saved !== null, null, {timeout: 30000});
+    let result = await saved();
+    check(result.written && result.path === savedPath && fs.existsSync(savedPath), `saved ${result.path}`);
+    check(JSON.stringify(result.values) === JSON.stringify(values), "with the values of the image shown");
+    const savedText = fs.readFileSync(savedPath, "utf8");
+    const dialogs = [];
+    page.once("dialog", (d) => { dialogs.push(d.message()); d.dismiss(); });
+    await page.evaluate(() => { whittedLive.saved = null; });
+    await page.click("#save");
+    await page.waitForFunction(() => whittedLive.saved !== null, null, {timeout: 30000});
+    result = await saved();
+    check(dialogs.length === 1 && dialogs[0].includes("Overwrite"), `the page asked before overwriting: ${dialogs}`);
+    check(!result.written && fs.readFileSync(savedPath, "utf8") === savedText &&
+          (await page.locator("#save-status").textContent()).includes("exists"),
+          "declined: the existing file is not written and the page says it exists");
+    page.once("dialog", (d) => d.accept());
+    await page.evaluate(() => { whittedLive.saved = null; });
+    await page.click("#save");
+    await page.waitForFunction(() => whittedLive.saved !== null, null, {timeout: 30000});
+    check((await saved()).written, "confirmed: the file is written again");
+
+    // 2d. check against POV-Ray: the verdict and the wipe (live_browser.py runs `whitted check`).
+    await page.click("#check");
+    await page.waitForSelector("#check-result[data-verdict=pass], #check-result[data-verdict=fail], " +
+                               "#check-result[data-verdict=error]", {timeout: 120000});
+    const checked = await page.evaluate(() => whittedLive.checked);
+    check(checked !== null, `the check ran: ${await page.locator("#check-result").textContent()}`);
+    if (checked) {
+        check(JSON.stringify(checked.values) === JSON.stringify(values), "the check used the values of the image shown");
+        const shownVerdict = await page.locator("#check-result").textContent();
+        check(shownVerdict.includes(checked.result.verdict) &&
+              shownVerdict.startsWith(checked.result.passed ? "PASS" : "FAIL"), `the page shows the verdict: ${shownVerdict}`);
+        const wiped = await page.evaluate(() => ["wipe-ours", "wipe-povray"].map((id) => document.getElementById(id).naturalWidth));
+        check(wiped[0] > 0 && wiped[1] > 0 && (await page.locator("#wipe").isVisible()), `the wipe shows both images ${wiped}`);
+        await page.locator("#wipe-at").fill("30");
+        check(/inset\(0(px)? 70% 0(px)? 0(px)?\)/.test(await page.locator("#wipe-ours").evaluate((e) => e.style.clipPath)),
+              "moving the wipe clips Whitted's image");
+        fs.writeFileSync(path.join(work, "check.json"), JSON.stringify(checked));
+        await page.screenshot({path: path.join(shots, "live-check.png"), fullPage: true});
+    }
+
     // 3. A bad edit of the file: the page shows the error where the image was.
     const original = fs.readFileSync(scenePath, "utf8");
     const bad = original.replace(/\bp: 10\b/, "p: [10");
@@ -100,8 +175,13 @@ async function settled(page, timeout) {
     await settled(page, 60000);
     check(await page.locator("#image").isVisible(), "the image is back once the file loads again");
     check((await shownPng(page)).equals(before), "and it is the file's own image again");
+    check((await page.locator("#explain").evaluate((e) => e.classList.contains("stale"))), "the explanation of the edited values is dimmed now");
 
-    const pageErrors = errors.slice();
+    // The server's two refusals of the save over the existing file (409, before the page asked)
+    // are logged by Chromium as failed loads: expected, and only those.
+    const refused = "Failed to load resource: the server responded with a status of 409 (Conflict)";
+    check(errors.filter((e) => e === refused).length === 2, "the two saves over the existing file met 409 first");
+    const pageErrors = errors.filter((e) => e !== refused);
     // From a blank page: the live page's own Content-Security-Policy (connect-src 'self') stops
     // its fetch before the route would see it.
     const blank = await context.newPage();
