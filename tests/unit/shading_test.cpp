@@ -176,6 +176,51 @@ TEST(Shading, PhongLobeClampsAtZeroWhereBlinnDoesNot) {
     EXPECT_NEAR(LectureShading::specular_lobe(blinn, up_normal, v, v), std::pow(std::cos(a), p), 1e-14);
 }
 
+// The local terms as one function, against the slide written out: ka·Ia + Σ over the lights
+// that arrive of kd·I·max(0, n·l) + ks·I·(n·h)^p. A light that does not arrive adds neither
+// term; one arriving with n·l < 0 (the course's convention, which has no gate) adds only its
+// highlight.
+TEST(Shading, LocalTermsAreTheSlide) {
+    const Color ka{0.1, 0.2, 0.3}, kd{0.5, 0.25, 0.125}, ks{0.3, 0.3, 0.6}, ambient{0.5, 1.0, 2.0};
+    const double p = 8;
+    const Material m = material(ka, kd, ks, p);
+    const double b = 30 * std::numbers::pi / 180;
+    const Vec3 l{-std::sin(b), std::cos(b), 0}, below{0, -std::sqrt(0.5), std::sqrt(0.5)};
+    const Color i1{1, 0.5, 0.25}, i2{2, 2, 2}, i3{0.25, 0.5, 1};
+    const ArrivingLight lights[] = {
+        {l, dot(up_normal, l), i1, true}, {below, 0.0, i2, false}, {below, dot(up_normal, below), i3, true}};
+    const auto lobe = [&](const Vec3& to_light) { return std::pow(dot(up_normal, normalize(to_eye + to_light)), p); };
+    const Color expected = ka * ambient + kd * i1 * std::cos(b) + ks * i1 * lobe(l) + ks * i3 * lobe(below);
+    expect_color_near(LectureShading::local_terms(m, ambient, up_normal, to_eye, lights, 3), expected, 1e-14);
+    // Each light's share is the same function's.
+    const LightShare share = LectureShading::light_terms(m, up_normal, to_eye, lights[2]);
+    expect_color_near(share.diffuse, Color(0.0), 0.0);
+    expect_color_near(share.specular, ks * i3 * lobe(below), 1e-14);
+    expect_color_near(LectureShading::ambient_term(m, ambient), ka * ambient, 0.0);
+}
+
+// r = 2(n·v)n − v: v at 60° from n on one side leaves at 60° on the other.
+TEST(Shading, MirrorDirectionIsVReflectedAboutN) {
+    const double a = 60 * std::numbers::pi / 180;
+    const Vec3 r = LectureShading::mirror_direction(up_normal, {std::sin(a), std::cos(a), 0});
+    expect_color_near(r, {-std::sin(a), std::cos(a), 0}, 1e-15);
+}
+
+// Without a glaze the mirror ray has weight km beside the whole local terms; with one, F·L(r)
+// beside (1 − F)·local, F = R0 + (1 − R0)(1 − n·v)^5.
+TEST(Shading, ReflectanceIsKmOrSchlicksSplit) {
+    Material m = material({}, {}, {}, 1);
+    m.km = {0.1, 0.2, 0.3};
+    const Reflectance plain = LectureShading::reflectance(m, up_normal, to_eye);
+    EXPECT_EQ(plain.local, 1.0);
+    expect_color_near(plain.mirror, m.km, 0.0);
+    m.fresnel_r0 = 0.04;
+    const double f = 0.04 + 0.96 * std::pow(1 - 1 / std::sqrt(2.0), 5);
+    const Reflectance glazed = LectureShading::reflectance(m, up_normal, to_eye);
+    EXPECT_NEAR(glazed.local, 1 - f, 1e-15);
+    expect_color_near(glazed.mirror, Color(f), 1e-15);
+}
+
 // Surfaces are two-sided: the floor seen from below, lit from below, shades like from above.
 TEST(Shading, BackFaceIsLitFromItsOwnSide) {
     const Color kd{0.3, 0.6, 0.9};

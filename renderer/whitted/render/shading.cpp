@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
+#include <new>
 
 namespace whitted {
 
@@ -30,16 +32,33 @@ double power(double x, double p) {
 }
 }  // namespace
 
-Color LectureShading::trace(const Ray& ray, int hits_so_far, RayCounts& counts) const {
-    Color radiance;
-    trace_packet(&ray, 1, hits_so_far, &radiance, counts);
-    return radiance;
+// ---- The slide -------------------------------------------------------------------------------
+//
+//   L = ka·Ia + Σ_i [ kd·I_i·max(0, n·l_i) + ks·I_i·max(0, n·h_i)^p ] + km·L(r) + kt·L(t)
+//
+// per hit and scalar. Which lights arrive (the convention's gate and the shadow rays) is decided
+// before, for a packet of hits at once; what r and t bring back is traced after, by the driver.
+
+Color LectureShading::local_terms(const Material& material, const Color& ambient_light, const Vec3& normal,
+                                  const Vec3& to_eye, const ArrivingLight* lights, size_t count) {
+    Color local = ambient_term(material, ambient_light);
+    for (size_t i = 0; i < count; ++i) {
+        if (!lights[i].arrives) continue;  // behind the surface, or in shadow: neither term
+        const LightShare share = light_terms(material, normal, to_eye, lights[i]);
+        local += share.diffuse + share.specular;
+    }
+    return local;
 }
 
-double LectureShading::schlick_fresnel(double r0, double n_dot_v) {
-    if (!(n_dot_v >= 0)) return 0.0;  // seen from behind (only with normals as given): no glaze
-    const double c = 1.0 - n_dot_v;
-    return r0 + (1.0 - r0) * (c * c * c * c * c);
+Color LectureShading::ambient_term(const Material& material, const Color& ambient_light) {
+    return material.ka * ambient_light;  // ka·Ia
+}
+
+LightShare LectureShading::light_terms(const Material& material, const Vec3& normal, const Vec3& to_eye,
+                                       const ArrivingLight& light) {
+    const Color& intensity = light.intensity;  // I_i, times the kt of any glass on the way
+    return {material.kd * intensity * std::max(0.0, light.n_dot_l),
+            material.ks * intensity * specular_lobe(material, normal, to_eye, light.to_light)};
 }
 
 double LectureShading::specular_lobe(const Material& material, const Vec3& normal, const Vec3& to_eye,
@@ -58,6 +77,115 @@ double LectureShading::specular_lobe(const Material& material, const Vec3& norma
     const double r_dot_l = dot(mirrored_view, to_light);
     return r_dot_l > 0 ? power(r_dot_l, material.p) : 0.0;
 }
+
+Vec3 LectureShading::mirror_direction(const Vec3& normal, const Vec3& to_eye) {
+    return normalize(normal * (2.0 * dot(normal, to_eye)) - to_eye);  // r = 2(n·v)n − v
+}
+
+namespace {
+/// The transmission step: the refracted direction t of the unit direction d at a surface with
+/// normal n, η = n_from / n_to, by Snell's law in Heckbert's form; false where there is none
+/// (total internal reflection). With n on the side d comes from and c = −d·n > 0:
+/// t = η d + (η c − √(1 − η²(1 − c²))) n.
+bool refraction_direction(const Vec3& d, const Vec3& normal, double eta, Vec3& t) {
+    double c = dot(d, normal);
+    Vec3 toward = normal;
+    if (c <= 0)
+        c = -c;
+    else
+        toward = -normal;
+    const double k = 1.0 + eta * eta * (c * c - 1.0);
+    if (k < 0) return false;
+    t = normalize(d * eta + toward * (eta * c - std::sqrt(k)));
+    return true;
+}
+}  // namespace
+
+// ---- The policies beside it ---------------------------------------------------------------------
+
+Reflectance LectureShading::reflectance(const Material& material, const Vec3& normal, const Vec3& to_eye) {
+    if (!(material.fresnel_r0 >= 0)) return {1.0, material.km};  // the lecture: km·L(r)
+    // Glazed: (1 − F)·(the other terms) + F·L(r), F from Schlick's approximation.
+    const double fresnel = schlick_fresnel(material.fresnel_r0, dot(normal, to_eye));
+    return {1.0 - fresnel, Color(fresnel)};
+}
+
+double LectureShading::schlick_fresnel(double r0, double n_dot_v) {
+    if (!(n_dot_v >= 0)) return 0.0;  // seen from behind (only with normals as given): no glaze
+    const double c = 1.0 - n_dot_v;
+    return r0 + (1.0 - r0) * (c * c * c * c * c);
+}
+
+namespace {
+/// Scene-format v1's convention, which is POV-Ray 3.7's: surfaces are two-sided (n turned toward
+/// the ray); a light counts only where n·l > 1e-10, and then with both its terms, so no highlight
+/// shows on the side a light does not reach; its shadow ray leaves x itself (no offset) and
+/// spans RaySpans' window from x to just short of the light.
+struct PovRayConvention {
+    static Vec3 normal(const SurfaceHit& hit, const Ray& ray) { return LectureShading::facing_normal(hit, ray); }
+    static double directional_light_distance(const RaySpans& spans, const Vec3& x, const Vec3& to_light) {
+        return spans.directional_light_distance(x, to_light);
+    }
+    static bool count(ArrivingLight& light, Ray& shadow_ray, const RaySpans& spans, const Vec3& x,
+                      double light_distance) {
+        light.arrives = light.n_dot_l > ray_limits::cosine_epsilon;
+        if (!light.arrives) return false;
+        const double window = spans.shadow(x);
+        shadow_ray = {x, light.to_light, window, light_distance - window};
+        return shadow_ray.t_max > shadow_ray.t_min;  // an empty span: the light is on the surface
+    }
+};
+
+/// The course's ray tracer (`convention: course`): every normal as given, so a back face is
+/// shaded dark; no gate: every light counts, its diffuse term is max(0, n·l) and its highlight
+/// comes as it is; the shadow ray spans (1e-6, 1) of the vector to the light, which for a
+/// directional light needs a finite distance.
+struct CourseConvention {
+    static Vec3 normal(const SurfaceHit& hit, const Ray&) { return hit.normal; }
+    static double directional_light_distance(const RaySpans&, const Vec3& x, const Vec3& to_light) {
+        return ray_limits::directional_light_distance - dot(x, to_light);
+    }
+    static bool count(ArrivingLight& light, Ray& shadow_ray, const RaySpans&, const Vec3& x, double light_distance) {
+        light.n_dot_l = std::max(0.0, light.n_dot_l);
+        light.arrives = true;
+        shadow_ray = {x, light.to_light, ray_limits::course_shadow_fraction * light_distance, light_distance};
+        return true;
+    }
+};
+
+/// `light` from x on a surface with normal n, under `Convention`: `seen` gets l, n·l and I, and
+/// `arrives` where the convention counts the light; `shadow_ray` is set where it counts (Ray{}
+/// elsewhere). True where the shadow ray is to be traced.
+template <class Convention>
+inline bool sight(const Light& light, const Vec3& x, const Vec3& normal, const RaySpans& spans, ArrivingLight& seen,
+                  Ray& shadow_ray) {
+    double light_distance;
+    seen.intensity = light.intensity;
+    if (light.type == LightType::point) {
+        const Vec3 offset = light.position - x;
+        light_distance = length(offset);
+        if (!(light_distance > 0)) {  // the light at x itself: no l, no terms
+            seen.to_light = Vec3{}, seen.n_dot_l = 0, seen.arrives = false, shadow_ray = Ray{};
+            return false;
+        }
+        seen.to_light = offset / light_distance;
+    } else {
+        seen.to_light = light.toward_light;
+        light_distance = Convention::directional_light_distance(spans, x, seen.to_light);
+    }
+    seen.n_dot_l = dot(normal, seen.to_light);
+    if (Convention::count(seen, shadow_ray, spans, x, light_distance)) return true;
+    if (!seen.arrives) shadow_ray = Ray{};
+    return false;
+}
+
+/// render.min_weight: a path fainter than this in every channel is not traced further.
+bool worth_tracing(const Color& weight, double min_weight) {
+    return !(std::max({weight.x, weight.y, weight.z}) < min_weight);
+}
+}  // namespace
+
+// ---- The driver: packets, shadow rays, observers -----------------------------------------------
 
 namespace {
 /// The observer of a render without layers: every call is empty and inlined away.
@@ -90,6 +218,12 @@ struct Watching {
     Watching for_lane(int i) const { return {to, at(i)}; }
 };
 }  // namespace
+
+Color LectureShading::trace(const Ray& ray, int hits_so_far, RayCounts& counts) const {
+    Color radiance;
+    trace_packet(&ray, 1, hits_so_far, &radiance, counts);
+    return radiance;
+}
 
 Color LectureShading::shadow_filter(Ray shadow_ray) const {
     // POV-Ray's walk: each surface met multiplies the light by its kt, and the search goes on
@@ -135,81 +269,24 @@ bool LectureShading::refract(const Ray& ray, const SurfaceHit& hit, const Vec3& 
         direction = ray.direction;
         return true;
     }
-    // Snell's law in Heckbert's form, with n the normal on the side the ray comes from and
-    // c = −d·n > 0: t = η d + (η c − √(1 − η²(1 − c²))) n; no root is total internal reflection.
-    double c = dot(ray.direction, normal);
-    Vec3 toward = normal;
-    if (c <= 0)
-        c = -c;
-    else
-        toward = -normal;
-    const double k = 1.0 + eta * eta * (c * c - 1.0);
-    if (k < 0) return false;
-    direction = normalize(ray.direction * eta + toward * (eta * c - std::sqrt(k)));
-    return true;
+    return refraction_direction(ray.direction, normal, eta, direction);
 }
 
-void LectureShading::direct_lighting(const SurfaceHit* hits, const Ray* rays, const bool* active, int count,
-                                     Color* local, Vec3* normal, RayCounts& counts) const {
-    NoObserver none;
-    direct_lighting_with(hits, rays, active, count, local, normal, counts, 0, none);
-}
-
-template <class Observer>
-void LectureShading::direct_lighting_with(const SurfaceHit* hits, const Ray* rays, const bool* active, int count,
-                                          Color* local, Vec3* normal, RayCounts& counts, int level,
-                                          Observer& observer) const {
-    const bool course = m_scene.convention == Convention::course;
-    for (int i = 0; i < count; ++i) {
-        if (!active[i]) continue;
-        // The course's ray tracer uses every normal as it is, so a back face is shaded dark.
-        normal[i] = course ? hits[i].normal : facing_normal(hits[i], rays[i]);
-        local[i] = m_scene.materials[hits[i].material].ka * m_scene.ambient;  // ambient: ka·Ia
-        observer.hit(i, level, rays[i], hits[i], normal[i]);
-        observer.ambient(i, level, local[i]);
-    }
-    for (size_t light_index = 0; light_index < m_scene.lights.size(); ++light_index) {
-        const Light& light = m_scene.lights[light_index];
-        PacketArray<Ray, packet_size> shadow_rays;  // set where `query`
-        bool query[packet_size] = {}, blocked[packet_size] = {}, lit[packet_size] = {};
-        double n_dot_l[packet_size];
+template <class Convention, class Observer>
+void LectureShading::see_lights(const Ray* rays, const SurfaceHit* hits, const Vec3* normal, const bool* active,
+                                int count, ArrivingLight* lights, RayCounts& counts, int level,
+                                Observer& observer) const {
+    const size_t light_count = m_scene.lights.size();
+    for (size_t k = 0; k < light_count; ++k) {
+        const Light& light = m_scene.lights[k];
+        PacketArray<Ray, packet_size> shadow_rays;  // set where `active`
+        bool tested[packet_size] = {}, blocked[packet_size] = {}, counted[packet_size] = {};
         for (int i = 0; i < count; ++i) {
             if (!active[i]) continue;
-            if constexpr (Observer::watching) shadow_rays[i] = Ray{}, n_dot_l[i] = 0;  // told even where unlit
-            const Vec3& point = hits[i].point;
-            Vec3 to_light;  // l
-            double light_distance;
-            if (light.type == LightType::point) {
-                const Vec3 offset = light.position - point;
-                light_distance = length(offset);
-                if (!(light_distance > 0)) continue;
-                to_light = offset / light_distance;
-            } else {
-                to_light = light.toward_light;
-                // The course's span is a fraction of the light's distance: it needs a finite one.
-                light_distance = course ? ray_limits::directional_light_distance - dot(point, to_light)
-                                        : m_spans.directional_light_distance(point, to_light);
-            }
-            n_dot_l[i] = dot(normal[i], to_light);
-            if constexpr (Observer::watching) shadow_rays[i].direction = to_light;  // l, also where unlit
-            if (course) {
-                // No gate: diffuse max(0, n·l), the highlight as it comes; the shadow ray spans
-                // (1e-6, 1) of the vector to the light.
-                n_dot_l[i] = std::max(0.0, n_dot_l[i]);
-                lit[i] = true;
-                shadow_rays[i] = {point, to_light, ray_limits::course_shadow_fraction * light_distance, light_distance};
-                query[i] = true;
-                counts.shadow += 1;
-                continue;
-            }
-            // The gate on both terms: a light behind the surface adds nothing.
-            if (!(n_dot_l[i] > ray_limits::cosine_epsilon)) continue;
-            lit[i] = true;
-            // Shadow ray from x itself (no offset; the window does the work) to just short of the light.
-            const double window = m_spans.shadow(point);
-            shadow_rays[i] = {point, to_light, window, light_distance - window};
-            query[i] = shadow_rays[i].t_max > shadow_rays[i].t_min;  // else the light is on the surface: unblocked
-            counts.shadow += query[i];
+            ArrivingLight& seen = lights[i * light_count + k];
+            tested[i] = sight<Convention>(light, hits[i].point, normal[i], m_spans, seen, shadow_rays[i]);
+            counted[i] = seen.arrives;
+            counts.shadow += tested[i];
         }
         // With transmitting surfaces in the scene a shadow ray is a walk (shadow_filter), else a
         // plain occlusion test.
@@ -217,46 +294,34 @@ void LectureShading::direct_lighting_with(const SurfaceHit* hits, const Ray* ray
         if (m_transmits) {
             for (int i = 0; i < count; ++i) {
                 filter[i] = Color(1.0);
-                if (!active[i] || !query[i]) continue;
+                if (!active[i] || !tested[i]) continue;
                 filter[i] = shadow_filter(shadow_rays[i]);
                 blocked[i] = is_zero(filter[i]);
             }
         } else {
-            m_accelerator.occluded_packet(shadow_rays.data(), query, count, blocked);
+            m_accelerator.occluded_packet(shadow_rays.data(), tested, count, blocked);
         }
         for (int i = 0; i < count; ++i) {
-            if constexpr (Observer::watching) {
-                if (active[i] && !(lit[i] && !(query[i] && blocked[i]))) {  // the light adds nothing here
-                    LightTerms terms;
-                    terms.to_light = shadow_rays[i].direction;
-                    terms.n_dot_l = n_dot_l[i];  // l and n·l stay 0 for a point light at x itself
-                    terms.facing = lit[i];
-                    if (lit[i]) terms.shadow_ray = shadow_rays[i];
-                    terms.shadow_tested = query[i];
-                    terms.blocked = query[i] && blocked[i];
-                    if (m_transmits) terms.filter = filter[i];
-                    observer.light(i, level, light_index, terms);
-                }
-            }
-            if (!lit[i] || (query[i] && blocked[i])) continue;  // a blocked light adds neither term
-            const Material& material = m_scene.materials[hits[i].material];
-            const Vec3& to_light = shadow_rays[i].direction;
-            const Color intensity = m_transmits ? light.intensity * filter[i] : light.intensity;
-            const Color diffuse = material.kd * intensity * n_dot_l[i];
-            const Color specular =
-                material.ks * intensity * specular_lobe(material, normal[i], -rays[i].direction, to_light);
-            local[i] += diffuse + specular;
+            if (!active[i]) continue;
+            ArrivingLight& arriving = lights[i * light_count + k];
+            if (m_transmits) arriving.intensity = light.intensity * filter[i];
+            arriving.arrives = counted[i] && !(tested[i] && blocked[i]);  // a blocked light adds neither term
             if constexpr (Observer::watching) {
                 LightTerms terms;
-                terms.to_light = to_light;
-                terms.n_dot_l = n_dot_l[i];
-                terms.facing = true;
+                terms.to_light = arriving.to_light;
+                terms.n_dot_l = arriving.n_dot_l;
+                terms.facing = counted[i];
                 terms.shadow_ray = shadow_rays[i];
-                terms.shadow_tested = query[i];
+                terms.shadow_tested = tested[i];
+                terms.blocked = tested[i] && blocked[i];
                 if (m_transmits) terms.filter = filter[i];
-                terms.diffuse = diffuse;
-                terms.specular = specular;
-                observer.light(i, level, light_index, terms);
+                if (arriving.arrives) {
+                    const LightShare share =
+                        light_terms(m_scene.materials[hits[i].material], normal[i], -rays[i].direction, arriving);
+                    terms.diffuse = share.diffuse;
+                    terms.specular = share.specular;
+                }
+                observer.light(i, level, k, terms);
             }
         }
     }
@@ -266,17 +331,23 @@ void LectureShading::trace_packet(const Ray* first_rays, int count, int hits_so_
                                   RayCounts& counts) const {
     NoObserver none;
     for (int i = 0; i < count; ++i) radiance[i] = Color(0.0);
-    trace_paths(first_rays, nullptr, nullptr, count, hits_so_far, radiance, counts, none);
+    if (m_scene.convention == Convention::course)
+        trace_paths<CourseConvention>(first_rays, nullptr, nullptr, count, hits_so_far, radiance, counts, none);
+    else
+        trace_paths<PovRayConvention>(first_rays, nullptr, nullptr, count, hits_so_far, radiance, counts, none);
 }
 
 void LectureShading::trace_packet(const Ray* first_rays, int count, int hits_so_far, Color* radiance, RayCounts& counts,
                                   PathObserver& observer) const {
     Watching watching{observer};
     for (int i = 0; i < count; ++i) radiance[i] = Color(0.0);
-    trace_paths(first_rays, nullptr, nullptr, count, hits_so_far, radiance, counts, watching);
+    if (m_scene.convention == Convention::course)
+        trace_paths<CourseConvention>(first_rays, nullptr, nullptr, count, hits_so_far, radiance, counts, watching);
+    else
+        trace_paths<PovRayConvention>(first_rays, nullptr, nullptr, count, hits_so_far, radiance, counts, watching);
 }
 
-template <class Observer>
+template <class Convention, class Observer>
 void LectureShading::trace_paths(const Ray* first_rays, const Color* first_weights, const Interiors* first_interiors,
                                  int count, int hits_so_far, Color* radiance, RayCounts& counts,
                                  Observer& observer) const {
@@ -291,6 +362,10 @@ void LectureShading::trace_paths(const Ray* first_rays, const Color* first_weigh
         if (first_interiors) interiors[i] = first_interiors[i];
         active[i] = true;
     }
+    // Every light as each hit sees it, lane by lane: raw room, filled before it is read.
+    const size_t light_count = m_scene.lights.size();
+    const std::unique_ptr<unsigned char[]> light_room(new unsigned char[sizeof(ArrivingLight) * light_count * count]);
+    ArrivingLight* const lights = std::launder(reinterpret_cast<ArrivingLight*>(light_room.get()));
     // A path segment past the last allowed surface hit contributes black, not the background
     // (POV-Ray's max_trace_level semantics, scene-format v1 `render.max_depth`).
     for (int level = hits_so_far; level < m_scene.max_depth; ++level) {
@@ -309,28 +384,28 @@ void LectureShading::trace_paths(const Ray* first_rays, const Color* first_weigh
         }
         if (!any_hit) break;
 
-        PacketArray<Color, packet_size> local;  // set where `active`
-        PacketArray<Vec3, packet_size> normal;
-        direct_lighting_with(hits.data(), rays.data(), active, count, local.data(), normal.data(), counts, level,
-                             observer);
+        PacketArray<Vec3, packet_size> normal;  // set where `active`
+        for (int i = 0; i < count; ++i) {
+            if (!active[i]) continue;
+            normal[i] = Convention::normal(hits[i], rays[i]);
+            observer.hit(i, level, rays[i], hits[i], normal[i]);
+            if constexpr (Observer::watching)
+                observer.ambient(i, level, ambient_term(m_scene.materials[hits[i].material], m_scene.ambient));
+        }
+        see_lights<Convention>(rays.data(), hits.data(), normal.data(), active, count, lights, counts, level, observer);
         for (int i = 0; i < count; ++i) {
             if (!active[i]) continue;
             const Material& material = m_scene.materials[hits[i].material];
             const Vec3 to_eye = -rays[i].direction;
-            Color mirror_weight = material.km;
-            Color added;
-            if (material.fresnel_r0 >= 0) {
-                // Glazed: (1 − F)·(the other terms) + F·L(r), F from Schlick's approximation.
-                const double fresnel = schlick_fresnel(material.fresnel_r0, dot(normal[i], to_eye));
-                added = weight[i] * local[i] * (1.0 - fresnel);
-                mirror_weight = Color(fresnel);
-            } else {
-                added = weight[i] * local[i];
-            }
+            const Color local =
+                local_terms(material, m_scene.ambient, normal[i], to_eye, &lights[i * light_count], light_count);
+            const Reflectance reflected = reflectance(material, normal[i], to_eye);
+            const Color added = weight[i] * local * reflected.local;
             radiance[i] += added;
-            observer.local(i, level, weight[i], local[i], added);
+            observer.local(i, level, weight[i], local, added);
             // kt·L(t): the refracted ray, or at total internal reflection the light back along r
             // with weight 1 in place of km (as POV-Ray 3.7 adds it, docs/pov-model.md §5).
+            Color mirror_weight = reflected.mirror;
             bool refracted = false;
             Ray refracted_ray;
             Interiors refracted_interiors;
@@ -345,31 +420,26 @@ void LectureShading::trace_paths(const Ray* first_rays, const Color* first_weigh
                 }
             }
             const Color refracted_weight = refracted ? weight[i] * material.kt : Color(0.0);
-            bool mirrored = !is_zero(mirror_weight) && level + 1 < m_scene.max_depth;
             const Color next_weight = weight[i] * mirror_weight;
-            // render.min_weight: too faint a path is not traced further.
-            if (mirrored && std::max({next_weight.x, next_weight.y, next_weight.z}) < m_scene.min_weight)
-                mirrored = false;
-            if (mirrored) {
-                // Mirror: r = 2(n·v)n − v, from the hit point itself (no offset; t_min does the work).
-                const Vec3 mirror_direction = normalize(normal[i] * (2.0 * dot(normal[i], to_eye)) - to_eye);
-                rays[i] = {hits[i].point, mirror_direction, m_spans.leaving(hits[i].point), m_spans.t_max()};
+            if (!is_zero(mirror_weight) && level + 1 < m_scene.max_depth &&
+                worth_tracing(next_weight, m_scene.min_weight)) {
+                // km·L(r): the mirror ray leaves the hit point itself (no offset; t_min does the work).
+                rays[i] = {hits[i].point, mirror_direction(normal[i], to_eye), m_spans.leaving(hits[i].point),
+                           m_spans.t_max()};
                 weight[i] = next_weight;
                 observer.mirror(i, level, rays[i], weight[i]);
                 ++counts.reflected;
             } else {
                 active[i] = false;
             }
-            if (refracted &&
-                !(std::max({refracted_weight.x, refracted_weight.y, refracted_weight.z}) < m_scene.min_weight)) {
+            if (refracted && worth_tracing(refracted_weight, m_scene.min_weight)) {
                 observer.transmitted(i, level, refracted_ray, refracted_weight);
                 ++counts.reflected;
                 Observer lane = observer.for_lane(i);
-                trace_paths(&refracted_ray, &refracted_weight, &refracted_interiors, 1, level + 1, &radiance[i], counts,
-                            lane);
+                trace_paths<Convention>(&refracted_ray, &refracted_weight, &refracted_interiors, 1, level + 1,
+                                        &radiance[i], counts, lane);
             }
         }
     }
 }
-
 }  // namespace whitted
