@@ -6,6 +6,7 @@ whitted_oiio (Release, no tests, for this interpreter), and build_ext copies int
     whitted.<EXT_SUFFIX>              the module, RPATH $ORIGIN/whitted.libs (cmake/WhittedWheel.cmake)
     whitted.libs/libwhitted.so.M.m    the library, under its SONAME
     whitted.libs/libwhitted_oiio.so   the plug-in libwhitted.so loads from its own folder
+    whitted.libs/libwhitted_{exr,tiff,jpeg}.so   the writers of those formats, plug-ins likewise
     whitted.pyi                       the type stubs
 Everything is built under $WHITTED_PIP_BUILD_DIR (default: build-pip/ here), never in build/.
 CMake options can be added in $CMAKE_ARGS; the build's parallelism is $CMAKE_BUILD_PARALLEL_LEVEL
@@ -24,6 +25,8 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 ROOT = os.path.dirname(os.path.abspath(__file__))
+# The image writers built as plug-ins (renderer/whitted/output/format_plugins.h).
+PLUGIN_FORMATS = ("exr", "tiff", "jpeg")
 BUILD = os.path.abspath(os.environ.get("WHITTED_PIP_BUILD_DIR") or os.path.join(ROOT, "build-pip"))
 CMAKE_BUILD = os.path.join(BUILD, "cmake")
 
@@ -67,7 +70,8 @@ class CMakeBuild(build_ext):
             configure += ["-G", "Ninja"]
         configure += shlex.split(os.environ.get("CMAKE_ARGS", ""))
         run("configure", configure)
-        build = ["cmake", "--build", CMAKE_BUILD, "--target", "whitted_python", "whitted_oiio"]
+        build = ["cmake", "--build", CMAKE_BUILD, "--target", "whitted_python", "whitted_oiio"] + [
+            f"whitted_{fmt}" for fmt in PLUGIN_FORMATS]
         if not os.environ.get("CMAKE_BUILD_PARALLEL_LEVEL"):
             build += ["--parallel", str(os.cpu_count() or 1)]
         run("build", build)
@@ -83,6 +87,8 @@ class CMakeBuild(build_ext):
                   (os.path.join(CMAKE_BUILD, "lib", soname), os.path.join(libs, soname)),
                   (os.path.join(CMAKE_BUILD, "lib", "libwhitted_oiio.so"), os.path.join(libs, "libwhitted_oiio.so")),
                   (os.path.join(ROOT, "renderer", "python", "whitted.pyi"), os.path.join(self.build_lib, "whitted.pyi"))]
+        copies += [(os.path.join(CMAKE_BUILD, "lib", f"libwhitted_{fmt}.so"), os.path.join(libs, f"libwhitted_{fmt}.so"))
+                   for fmt in PLUGIN_FORMATS]
         for source, target in copies:
             if not os.path.isfile(source):
                 fail(f"the build made no {source}")

@@ -636,3 +636,8 @@ int run_live(const LiveArguments& args) {
 }
 
 }  // namespace whitted
+
+// The entry point of lib/libwhitted_live.so (live_plugin.cpp loads it).
+extern "C" __attribute__((visibility("default"))) int whitted_run_live(const whitted::LiveArguments& args) {
+    return whitted::run_live(args);
+}

@@ -18,7 +18,8 @@ prefix="$work/prefix"
 cmake --install "$build" --prefix "$prefix" >"$work/install.log"
 for f in include/whitted/whitted.h include/whitted/image.h include/whitted/version.h \
          "$libdir/cmake/Whitted/WhittedConfig.cmake" "$libdir/cmake/Whitted/WhittedConfigVersion.cmake" \
-         "$libdir/pkgconfig/whitted.pc" bin/whitted "$libdir/libwhitted_oiio.so"; do
+         "$libdir/pkgconfig/whitted.pc" bin/whitted "$libdir/libwhitted_oiio.so" \
+         "$libdir/libwhitted_live.so" "$libdir/libwhitted_exr.so" "$libdir/libwhitted_tiff.so" "$libdir/libwhitted_jpeg.so"; do
   [ -e "$prefix/$f" ] || { echo "FAIL: $f not installed"; exit 1; }
 done
 ls "$prefix/$libdir/libwhitted.so.0.2" >/dev/null

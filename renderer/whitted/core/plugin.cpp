@@ -13,10 +13,15 @@
 namespace whitted {
 namespace {
 
+void* open_plugin(const std::vector<std::filesystem::path>& candidates, const char* plugin_file,
+                  const char* needed_for);
+
 void* load_plugin(const char* plugin_file, const char* needed_for) {
     std::vector<std::filesystem::path> candidates;
-    if (const char* dir = std::getenv("WHITTED_PLUGIN_DIR"); dir && *dir) candidates.emplace_back(dir);
     std::error_code error;
+    // $WHITTED_PLUGIN_DIR, when set, is the only place: one set of plug-ins, not a mix.
+    if (const char* dir = std::getenv("WHITTED_PLUGIN_DIR"); dir && *dir)
+        return open_plugin({dir}, plugin_file, needed_for);
     const auto exe = std::filesystem::read_symlink("/proc/self/exe", error);
     if (!error) candidates.push_back(exe.parent_path().parent_path() / "lib");
 #ifdef WHITTED_INSTALL_LIBDIR
@@ -33,6 +38,12 @@ void* load_plugin(const char* plugin_file, const char* needed_for) {
 #ifdef WHITTED_BUILD_PLUGIN_DIR
     candidates.emplace_back(WHITTED_BUILD_PLUGIN_DIR);
 #endif
+    return open_plugin(candidates, plugin_file, needed_for);
+}
+
+void* open_plugin(const std::vector<std::filesystem::path>& candidates, const char* plugin_file,
+                  const char* needed_for) {
+    std::error_code error;
     std::string tried;
     for (const auto& dir : candidates) {
         const std::filesystem::path path = dir / plugin_file;

@@ -10,7 +10,8 @@ namespace whitted {
 /// would cost every run about 0.2 s of start-up (it pulls in ~250 shared libraries), most of a
 /// small render's time; a render never loads it.
 ///
-/// Returns the address of `name` in the plug-in, loading it from $WHITTED_PLUGIN_DIR, else from
+/// Returns the address of `name` in the plug-in, loading it from $WHITTED_PLUGIN_DIR (when set,
+/// the only place looked), else from
 /// ../lib (and ../<install libdir>) beside the running program, else from the directory of the
 /// shared object holding this code (libwhitted.so, for a program that links the library), else
 /// from the build tree. Throws std::runtime_error

@@ -1,22 +1,12 @@
 // SPDX-License-Identifier: MIT
 #include "whitted/output/image_output.h"
 
+#include "whitted/core/plugin.h"
 #include "whitted/output/atomic_files.h"
 #include "whitted/output/color_management.h"
+#include "whitted/output/format_plugins.h"
 #include "whitted/output/icc_profile.h"
-#include "whitted/output/jpeg_file.h"
-
 #include "whitted/output/png_file.h"
-#include "whitted/output/tiff_file.h"
-
-#include <Imath/half.h>
-#include <OpenEXR/ImfChannelList.h>
-#include <OpenEXR/ImfFrameBuffer.h>
-#include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfOutputFile.h>
-#include <OpenEXR/ImfStandardAttributes.h>
-#include <OpenEXR/ImfStringAttribute.h>
-#include <OpenEXR/ImfThreading.h>
 
 #include <unistd.h>
 #include <climits>
@@ -27,7 +17,6 @@
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
-#include <thread>
 
 namespace whitted {
 namespace {
@@ -67,6 +56,28 @@ OutputKind output_kind(const std::string& path) {
                                 "'; use .exr (linear), .png, .jpg or .tif (display-referred)");
 }
 
+void* format_writer(const std::string& ext) {
+    struct Plugin {
+        const char* file;
+        const char* symbol;
+        const char* needed_for;
+    };
+    Plugin plugin{};
+    if (ext == ".exr")
+        plugin = {"libwhitted_exr.so", "whitted_write_exr", "the OpenEXR writer, needed to write .exr files"};
+    else if (ext == ".tif" || ext == ".tiff")
+        plugin = {"libwhitted_tiff.so", "whitted_write_tiff", "the TIFF writer, needed to write .tif files"};
+    else if (ext == ".jpg" || ext == ".jpeg")
+        plugin = {"libwhitted_jpeg.so", "whitted_write_jpeg", "the JPEG writer, needed to write .jpg files"};
+    else
+        return nullptr;
+    try {
+        return plugin_symbol(plugin.file, plugin.symbol, plugin.needed_for);
+    } catch (const std::runtime_error& e) {
+        throw std::invalid_argument(e.what());
+    }
+}
+
 void check_output_path(const std::string& path) {
     output_kind(path);
     const std::filesystem::path p(path);
@@ -93,6 +104,7 @@ bool is_tiff(const std::string& ext) {
 /// The checks of check_output_options that need no config.
 void check_format_options(const std::string& path, const OutputOptions& options) {
     const std::string ext = lower_extension(path);
+    format_writer(ext);  // the plug-in writing the format is there and loads
     if (output_kind(path) == OutputKind::linear_exr) {
         const auto refuse = [&](const std::string& option) {
             throw std::invalid_argument(option + " cannot apply to '" + path +
@@ -141,75 +153,6 @@ void check_output_options(const std::string& path, const OutputOptions& options)
 
 namespace {
 
-Imf::Compression exr_compression(const std::string& name) {
-    if (name.empty() || name == "none") return Imf::NO_COMPRESSION;
-    if (name == "zip") return Imf::ZIP_COMPRESSION;
-    if (name == "zips") return Imf::ZIPS_COMPRESSION;
-    if (name == "piz") return Imf::PIZ_COMPRESSION;
-    if (name == "rle") return Imf::RLE_COMPRESSION;
-    throw std::invalid_argument("unknown EXR compression '" + name + "'; use none, zip, zips, piz or rle");
-}
-
-void write_exr(const Image& image, const std::string& temp_path, bool half, Imf::Compression compression,
-               const std::vector<std::pair<std::string, std::string>>& metadata) {
-    // OpenEXR directly (not through OpenImageIO) keeps EXR renders free of OpenImageIO's
-    // start-up cost; ZIP blocks are compressed on all cores.
-    Imf::setGlobalThreadCount(compression == Imf::NO_COMPRESSION ? 0 : int(std::thread::hardware_concurrency()));
-    Imf::Header header(image.width, image.height);
-    // Uncompressed by default: deflate (zip) on a 1280x960 float image took 0.3-0.4 s, as long as
-    // rendering it, to save about a third of the bytes (docs/performance.md). --exr-compression
-    // picks another lossless scheme.
-    header.compression() = compression;
-    header.zipCompressionLevel() = 1;
-    const Imf::PixelType type = half ? Imf::HALF : Imf::FLOAT;
-    for (const char* channel : {"R", "G", "B"}) header.channels().insert(channel, Imf::Channel(type));
-    for (const auto& [key, value] : metadata) header.insert(key, Imf::StringAttribute(value));
-    // The standard attribute readers look for (OpenEXR's Chromaticities: Rec.709 primaries, D65).
-    Imf::addChromaticities(header, Imf::Chromaticities());
-    std::vector<Imath::half> halves;
-    const char* base = reinterpret_cast<const char*>(image.rgb.data());
-    size_t element = sizeof(float);
-    if (half) {
-        halves.assign(image.rgb.begin(), image.rgb.end());
-        base = reinterpret_cast<const char*>(halves.data());
-        element = sizeof(Imath::half);
-    }
-    Imf::FrameBuffer frame;
-    const char* names[] = {"R", "G", "B"};
-    for (int c = 0; c < 3; ++c)
-        frame.insert(names[c], Imf::Slice(type, const_cast<char*>(base + c * element), 3 * element,
-                                          3 * element * size_t(image.width)));
-    // Render layers: `layer.channel` names as Nuke and Blender read them (docs/layers.md). Data
-    // layers (normals, positions, ids) stay 32-bit float even with --half: half holds integers
-    // exactly only up to 2048.
-    std::vector<std::vector<Imath::half>> layer_halves(image.layers.size());
-    for (size_t l = 0; l < image.layers.size(); ++l) {
-        const ImageLayer& layer = image.layers[l];
-        const size_t channels = layer.channels.size();
-        const Imf::PixelType layer_type = layer.data ? Imf::FLOAT : type;
-        const char* layer_base = reinterpret_cast<const char*>(layer.values.data());
-        size_t layer_element = sizeof(float);
-        if (layer_type == Imf::HALF) {
-            layer_halves[l].assign(layer.values.begin(), layer.values.end());
-            layer_base = reinterpret_cast<const char*>(layer_halves[l].data());
-            layer_element = sizeof(Imath::half);
-        }
-        for (size_t c = 0; c < channels; ++c) {
-            header.channels().insert(layer.channels[c], Imf::Channel(layer_type));
-            frame.insert(layer.channels[c],
-                         Imf::Slice(layer_type, const_cast<char*>(layer_base + c * layer_element),
-                                    channels * layer_element, channels * layer_element * size_t(image.width)));
-        }
-    }
-    try {
-        Imf::OutputFile file(temp_path.c_str(), header);
-        file.setFrameBuffer(frame);
-        file.writePixels(image.height);
-    } catch (const std::exception& e) {
-        throw std::runtime_error(std::string("OpenEXR: ") + e.what());
-    }
-}
-
 /// write_image's work, into `temp_path`.
 void write_to(const std::string& temp_path, const Image& image, const std::string& path, const OutputOptions& options,
               std::vector<std::pair<std::string, std::string>> metadata) {
@@ -218,7 +161,8 @@ void write_to(const std::string& temp_path, const Image& image, const std::strin
     if (kind == OutputKind::linear_exr) {
         metadata.push_back({"whitted:colorspace", "Linear Rec.709 (sRGB)"});
         metadata.insert(metadata.end(), options.metadata.begin(), options.metadata.end());
-        write_exr(image, temp_path, options.half, exr_compression(options.exr_compression), metadata);
+        const auto write_exr = reinterpret_cast<WriteExrFunction>(format_writer(ext));
+        write_exr(temp_path, image, options.half, options.exr_compression, metadata);
     } else {
         const DisplayTransform display(options.ocio_config, options.display, options.view);
         const int bits = options.bit_depth ? options.bit_depth : (is_tiff(ext) ? 16 : 8);
@@ -237,9 +181,11 @@ void write_to(const std::string& temp_path, const Image& image, const std::strin
                 icc_profile(display.encoding(), "Whitted: " + display.display() + " / " + display.view() + " (" +
                                                     display.colorspace() + ")");
             if (is_jpeg(ext))
-                write_jpeg(temp_path, image.width, image.height, pixels.data(), metadata, profile);
+                reinterpret_cast<WriteJpegFunction>(format_writer(ext))(temp_path, image.width, image.height,
+                                                                        pixels.data(), metadata, profile);
             else
-                write_tiff(temp_path, image.width, image.height, pixels.data(), bits, metadata, profile);
+                reinterpret_cast<WriteTiffFunction>(format_writer(ext))(temp_path, image.width, image.height,
+                                                                        pixels.data(), bits, metadata, profile);
         }
     }
 }

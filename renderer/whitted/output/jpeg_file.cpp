@@ -6,6 +6,8 @@
 
 #include "whitted/output/jpeg_file.h"
 
+#include "whitted/output/format_plugins.h"
+
 #include <jpeglib.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -161,3 +163,9 @@ void write_jpeg(const std::string& path, int width, int height, const float* rgb
 }
 
 }  // namespace whitted
+
+extern "C" WHITTED_PLUGIN_EXPORT void whitted_write_jpeg(const std::string& path, int width, int height,
+                                                         const float* rgb, const whitted::ImageMetadata& metadata,
+                                                         const std::vector<unsigned char>& icc_profile) {
+    whitted::write_jpeg(path, width, height, rgb, metadata, icc_profile);
+}

@@ -5,6 +5,8 @@
 
 #include "whitted/output/tiff_file.h"
 
+#include "whitted/output/format_plugins.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tiffio.h>
@@ -112,3 +114,10 @@ void write_tiff(const std::string& path, int width, int height, const float* rgb
 }
 
 }  // namespace whitted
+
+extern "C" WHITTED_PLUGIN_EXPORT void whitted_write_tiff(const std::string& path, int width, int height,
+                                                         const float* rgb, int bits,
+                                                         const whitted::ImageMetadata& metadata,
+                                                         const std::vector<unsigned char>& icc_profile) {
+    whitted::write_tiff(path, width, height, rgb, bits, metadata, icc_profile);
+}
