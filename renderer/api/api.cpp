@@ -517,13 +517,15 @@ Expected<void> write_image(const Image& image, const std::string& path, const Wr
 
 Expected<std::string> to_povray(const Scene& scene) {
     return guarded<std::string>("converting " + scene.path(), [&]() -> Expected<std::string> {
-        return pov::scene_to_sdl(impl_of(scene).converter_description());
+        const Scene::Impl& loaded = impl_of(scene);
+        return pov::scene_to_sdl(loaded.converter_description(), loaded.scene);
     });
 }
 
 Expected<std::string> write_povray(const Scene& scene, const std::string& pov_path) {
     return guarded<std::string>("converting " + scene.path(), [&]() -> Expected<std::string> {
-        return pov::write_pov_files(impl_of(scene).converter_description(), pov_path);
+        const Scene::Impl& loaded = impl_of(scene);
+        return pov::write_pov_files(loaded.converter_description(), loaded.scene, pov_path);
     });
 }
 

@@ -490,7 +490,8 @@ int run_convert(const std::string& scene_path, const std::string& output) {
         if (!to_yaml) refuse_symlink_target(ini_path);
         const InputFilesNoted inputs;  // the scene, its meshes and MTL files, as they are read
         const SceneDescription description = parse_scene_file(scene_path);
-        validate_scene(description);  // refuse what Whitted itself would refuse; reads the meshes
+        // Refuses what Whitted itself would refuse; reads the meshes once, for the writer too.
+        const Scene built = validate_scene(description);
         // An output that is a mesh or MTL file of the scene under another name (`mtllib
         // out.ini`, a mesh named `mesh.pov`): refused before a byte is written.
         for (const std::filesystem::path& target : {std::filesystem::path(output), ini_path}) {
@@ -505,7 +506,7 @@ int run_convert(const std::string& scene_path, const std::string& output) {
             std::fprintf(stderr, "whitted: wrote %s\n", output.c_str());
             return exit_ok;
         }
-        const std::string ini = pov::write_pov_files(description, output);
+        const std::string ini = pov::write_pov_files(description, built, output);
         std::fprintf(stderr, "whitted: wrote %s and %s\n", output.c_str(), ini.c_str());
         return exit_ok;
     } catch (...) {
