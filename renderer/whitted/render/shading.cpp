@@ -243,8 +243,11 @@ void LectureShading::direct_lighting_with(const SurfaceHit* hits, const Ray* ray
             const Vec3& to_light = shadow_rays[i].direction;
             const Color intensity = m_transmits ? light.intensity * filter[i] : light.intensity;
             const Color diffuse = material.kd * intensity * n_dot_l[i];
-            const Color specular =
-                material.ks * intensity * specular_lobe(material, normal[i], -rays[i].direction, to_light);
+            // ks = 0 (most NFF fills): the lobe (often a pow) is not computed. It is finite and
+            // never negative, so ks·I·0 is the same zero, sign included.
+            const double lobe =
+                is_zero(material.ks) ? 0.0 : specular_lobe(material, normal[i], -rays[i].direction, to_light);
+            const Color specular = material.ks * intensity * lobe;
             local[i] += diffuse + specular;
             if constexpr (Observer::watching) {
                 LightTerms terms;
