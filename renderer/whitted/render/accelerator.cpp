@@ -1295,6 +1295,13 @@ struct Accelerator::Impl {
     }
 
     void intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found) const {
+        // One ray (a refracted path) goes through Embree's single-ray traversal: a W-wide packet
+        // with one lane in use walks the same nodes at W lanes' cost.
+        if (count == 1) {
+            if (active[0]) found[0] = intersect(rays[0], hits[0]);
+            embree_error.throw_if_failed("while tracing rays");
+            return;
+        }
         QueryContext context(rays, active, count, true);
         const bool traced = in_native_groups(
             count, [&]<int W>(int first) { intersect_lanes<W>(context, rays, active, first, count, hits, found); });
@@ -1350,6 +1357,11 @@ struct Accelerator::Impl {
     }
 
     void occluded_packet(const Ray* rays, const bool* active, int count, bool* blocked) const {
+        if (count == 1) {  // one ray, as in intersect_packet
+            if (active[0]) blocked[0] = occluded(rays[0]);
+            embree_error.throw_if_failed("while tracing shadow rays");
+            return;
+        }
         // Planes first (no BVH): a ray a plane blocks needs no Embree query.
         bool query[packet_size];
         for (int i = 0; i < count; ++i) query[i] = active[i] && !(blocked[i] = occluded_by_plane(rays[i]));

@@ -57,8 +57,10 @@ Color LectureShading::ambient_term(const Material& material, const Color& ambien
 LightShare LectureShading::light_terms(const Material& material, const Vec3& normal, const Vec3& to_eye,
                                        const ArrivingLight& light) {
     const Color& intensity = light.intensity;  // I_i, times the kt of any glass on the way
-    return {material.kd * intensity * std::max(0.0, light.n_dot_l),
-            material.ks * intensity * specular_lobe(material, normal, to_eye, light.to_light)};
+    // Where ks = 0 (most NFF fills) the lobe, often a pow, is not computed: it is finite and never
+    // negative, so ks·I·0 is the same zero, sign included.
+    const double lobe = is_zero(material.ks) ? 0.0 : specular_lobe(material, normal, to_eye, light.to_light);
+    return {material.kd * intensity * std::max(0.0, light.n_dot_l), material.ks * intensity * lobe};
 }
 
 double LectureShading::specular_lobe(const Material& material, const Vec3& normal, const Vec3& to_eye,

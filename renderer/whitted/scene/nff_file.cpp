@@ -34,7 +34,7 @@ struct Token {
 class NffReader {
 public:
     NffReader(std::string_view text, std::string path, const ObjectSink* sink)
-        : m_text(text), m_path(std::move(path)), m_sink(sink) {}
+        : m_text(text), m_path(std::move(path)), m_file(m_path), m_sink(sink) {}
 
     SceneDescription read() {
         m_scene.path = m_path;
@@ -117,10 +117,10 @@ private:
         return token;
     }
 
-    SourceLocation where(const Token& token) const { return {m_path, token.line, token.column}; }
-    SourceLocation at_start() const { return {m_path, 1, 1}; }
+    SourceLocation where(const Token& token) const { return {m_file, token.line, token.column}; }
+    SourceLocation at_start() const { return {m_file, 1, 1}; }
     /// Just past the last token read: where a missing value should have been.
-    SourceLocation here() const { return {m_path, m_end_line, m_end_column}; }
+    SourceLocation here() const { return {m_file, m_end_line, m_end_column}; }
     [[noreturn]] void fail(const Token& token, const std::string& message) const {
         throw InputError(where(token), message);
     }
@@ -406,6 +406,9 @@ private:
 
     std::string_view m_text;
     std::string m_path;
+    /// The path as kept for every location: made once, since making one looks the name up in
+    /// the shared table (a lock and a hash), and every number read records where it was.
+    FileName m_file;
     const ObjectSink* m_sink = nullptr;
     size_t m_emitted = 0;
     size_t m_pos = 0, m_line_start = 0;
