@@ -6,6 +6,7 @@
 #include "reference/check.h"
 #include "reference/file_colour.h"
 #include "whitted/scene/source_location.h"
+#include "whitted/scene/text_checks.h"
 #include "whitted/whitted.h"
 
 #include <OpenImageIO/imageio.h>
@@ -37,6 +38,11 @@ __attribute__((visibility("default"))) int whitted_run_check(const std::string& 
         return 2;
     } catch (const std::bad_alloc&) {
         std::fprintf(stderr, "whitted: error: out of memory while checking %s\n", scene_path.c_str());
+        return 1;
+    } catch (const whitted::FileChangedWhileRead& e) {
+        // Not the input's fault: another program changed it under the reader, a failure (exit
+        // 1) as for `whitted render` (docs/robustness.md, "Files that change while they are read").
+        std::fprintf(stderr, "whitted: error: %s: %s\n", scene_path.c_str(), e.what());
         return 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "whitted: error: %s\n", e.what());

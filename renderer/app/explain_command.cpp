@@ -364,6 +364,9 @@ int run_explain(const std::string& scene_path, const std::string& pixel, bool js
     } catch (const std::invalid_argument& e) {
         print_error(e.what());
         return exit_bad_input;
+    } catch (const FileChangedWhileRead& e) {  // another program changed it: a failure, as for render
+        print_error(scene_path + ": " + e.what());
+        return exit_failure;
     } catch (const std::exception& e) {
         print_error(scene_path + ": " + e.what());
         return exit_bad_input;
