@@ -779,6 +779,11 @@ struct Accelerator::Impl {
         // finite shapes before it is traced (intersect, occluded): the rule holds for it too.
         finite_shapes_reach = finite_reach;
         rule_origins = origins;
+        const auto transformed = [](const auto& shape) { return bool(shape.object_to_world); };
+        rule_applies = !scene.instances.empty() ||
+                       std::any_of(scene.spheres.begin(), scene.spheres.end(), transformed) ||
+                       std::any_of(scene.boxes.begin(), scene.boxes.end(), transformed) ||
+                       std::any_of(scene.cones.begin(), scene.cones.end(), transformed);
         // How far from the origin of an object's own space the rays start there.
         const auto origins_in_own_space = [&](const Transform& to_world) {
             const double shrink = largest(to_world.inverse_vector({1, 0, 0})) +
@@ -867,6 +872,10 @@ struct Accelerator::Impl {
     /// check_reach's bounds, each on every axis: every finite shape lies within
     /// finite_shapes_reach of the origin, and its rule holds for rays starting within rule_origins.
     double finite_shapes_reach = 0, rule_origins = 0;
+    /// Whether the scene has what the rule is for: an instance, or a sphere, box or cone with a
+    /// transform. Without one, Embree takes the world's rays as they are (a plane's far hits stay
+    /// well within its 1.8e19), and every answer is the double test's on the ray itself.
+    bool rule_applies = false;
 
     /// Whether `ray` starts where check_reach's rule does not reach: only a plane's far hits
     /// (up to RaySpans::far_t_max = 1e16 from the eye, and further after bounces between planes)
@@ -875,7 +884,8 @@ struct Accelerator::Impl {
     /// there: the shadow ray from a floor's hit 1e11 away gave Embree an origin of 1e19 in the
     /// space of an instance scaled by 1e-8 (an abort).
     bool starts_afar(const Ray& ray) const {
-        return std::max({std::fabs(ray.origin.x), std::fabs(ray.origin.y), std::fabs(ray.origin.z)}) > rule_origins;
+        return rule_applies &&
+               std::max({std::fabs(ray.origin.x), std::fabs(ray.origin.y), std::fabs(ray.origin.z)}) > rule_origins;
     }
 
     /// `ray` (starting afar) from where it enters the cube that holds every finite shape: its
@@ -884,7 +894,7 @@ struct Accelerator::Impl {
     /// the cube (its rounding, an ulp of the far origin, is the ray's own uncertainty), so the
     /// rule bounds it.
     bool toward_finite_shapes(const Ray& ray, Ray& near, double& skipped) const {
-        const double cube = finite_shapes_reach;  // not above rule_origins: `near` starts within it
+        const double cube = finite_shapes_reach;
         double enter = 0, leave = ray.t_max;
         const double origin[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
         const double direction[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
@@ -899,9 +909,12 @@ struct Accelerator::Impl {
             leave = std::min(leave, b);
         }
         if (!(enter <= leave) || !(leave > ray.t_min)) return false;
-        skipped = enter;
-        const Vec3 at = ray.at(enter);
-        near.origin = Vec3(std::clamp(at.x, -cube, cube), std::clamp(at.y, -cube, cube), std::clamp(at.z, -cube, cube));
+        // A little before the cube, so that a shape on its face is still ahead of `near`.
+        const double margin = 1e-6 * cube, outer = cube + 2 * margin;
+        skipped = std::max(0.0, enter - margin);
+        const Vec3 at = ray.at(skipped);
+        near.origin =
+            Vec3(std::clamp(at.x, -outer, outer), std::clamp(at.y, -outer, outer), std::clamp(at.z, -outer, outer));
         near.direction = ray.direction;
         near.t_min = std::max(ray.t_min - enter, 0.0);
         near.t_max = ray.t_max - enter;
@@ -1248,7 +1261,11 @@ struct Accelerator::Impl {
 
     /// The nearest hit on `ray`: Embree's nearest candidate, when the double test accepts it.
     bool intersect(const Ray& ray, SurfaceHit& out) const {
-        if (starts_afar(ray)) return intersect_from_afar(ray, out);
+        return starts_afar(ray) ? intersect_from_afar(ray, out) : intersect_from_here(ray, out);
+    }
+
+    /// intersect for a ray that does not start afar (or has been brought near).
+    bool intersect_from_here(const Ray& ray, SurfaceHit& out) const {
         bool retry = false;
         const bool found = trace(ray, nullptr, out, retry);
         return retry ? intersect_again(ray, out) : found;
@@ -1267,7 +1284,7 @@ struct Accelerator::Impl {
         if (before.t_max > before.t_min &&
             finish_hit(before, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, {}, false, out, retry))
             return true;
-        if (!intersect(near, out)) return false;
+        if (!intersect_from_here(near, out)) return false;
         out.t += skipped;
         return true;
     }
@@ -1407,8 +1424,13 @@ struct Accelerator::Impl {
         if (starts_afar(ray)) {
             Ray near;
             double skipped = 0;
-            return toward_finite_shapes(ray, near, skipped) && near.t_max > near.t_min && occluded(near);
+            return toward_finite_shapes(ray, near, skipped) && near.t_max > near.t_min && occluded_in_bvh(near);
         }
+        return occluded_in_bvh(ray);
+    }
+
+    /// Embree's answer for a shadow ray, the planes aside.
+    bool occluded_in_bvh(const Ray& ray) const {
         QueryContext context(&ray, nullptr, 1, false);
         context.embree.filter = shadow_filter();
         RTCRay r = make_embree_ray(ray, 0, frame);
