@@ -7,6 +7,7 @@
 #include "reference/check.h"
 #include "reference/file_colour.h"
 #include "whitted/scene/source_location.h"
+#include "whitted/scene/text_checks.h"
 #include "whitted/whitted.h"
 
 #include <OpenImageIO/imageio.h>

@@ -87,15 +87,39 @@ bool reap(pid_t pid, int& status, std::chrono::milliseconds limit) {
     }
 }
 
-/// Ends POV-Ray: SIGTERM lets it exit by itself, SIGKILL follows if it does not within 2 s.
+/// Ends POV-Ray and whatever it started: SIGTERM to its process group lets it exit by itself,
+/// SIGKILL to the group follows if it does not within 2 s, and once more after it is reaped, for
+/// what outlives it (the POV-Ray a wrapper script runs as its child: SIGTERM to the script alone
+/// left that child rendering). The group's id cannot be reused while a member lives.
 void stop(pid_t pid) {
     int status = 0;
-    ::kill(pid, SIGTERM);
-    if (reap(pid, status, std::chrono::milliseconds(2000))) return;
-    ::kill(pid, SIGKILL);
-    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    ::kill(-pid, SIGTERM);
+    if (!reap(pid, status, std::chrono::milliseconds(2000))) {
+        ::kill(-pid, SIGKILL);
+        while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+        }
     }
+    ::kill(-pid, SIGKILL);
 }
+
+/// posix_spawn's attributes, freed on every path out: POV-Ray in a process group of its own.
+class SpawnGroup {
+public:
+    SpawnGroup() {
+        ::posix_spawnattr_init(&m_attributes);
+        m_ready = ::posix_spawnattr_setflags(&m_attributes, POSIX_SPAWN_SETPGROUP) == 0 &&
+                  ::posix_spawnattr_setpgroup(&m_attributes, 0) == 0;
+    }
+    ~SpawnGroup() { ::posix_spawnattr_destroy(&m_attributes); }
+    SpawnGroup(const SpawnGroup&) = delete;
+    SpawnGroup& operator=(const SpawnGroup&) = delete;
+    const posix_spawnattr_t* get() const { return &m_attributes; }
+    bool ready() const { return m_ready; }
+
+private:
+    posix_spawnattr_t m_attributes;
+    bool m_ready = false;
+};
 
 }  // namespace
 
@@ -169,9 +193,13 @@ PovrayRun run_povray(const std::string& ini_path, const std::string& log_path, c
         ::posix_spawn_file_actions_adddup2(actions.get(), STDOUT_FILENO, STDERR_FILENO) != 0)
         throw std::runtime_error("cannot prepare to run POV-Ray: " + std::string(std::strerror(errno)));
 
+    // Its own process group, so that stop() ends everything it started. Ctrl-C in a terminal
+    // then reaches whitted alone, which stops POV-Ray the same way.
+    const SpawnGroup group;
+    if (!group.ready()) throw std::runtime_error("cannot prepare to run POV-Ray: " + std::string(std::strerror(errno)));
     const auto start = std::chrono::steady_clock::now();
     pid_t pid = 0;
-    if (const int error = ::posix_spawn(&pid, program.c_str(), actions.get(), nullptr, argv.data(), envp.data()))
+    if (const int error = ::posix_spawn(&pid, program.c_str(), actions.get(), group.get(), argv.data(), envp.data()))
         throw std::runtime_error("cannot run '" + program + "': " + std::strerror(error));
     int status = 0;
     while (!reap(pid, status, std::chrono::milliseconds(50))) {
@@ -180,7 +208,7 @@ PovrayRun run_povray(const std::string& ini_path, const std::string& log_path, c
             throw Interrupted();  // `home` (POV-Ray's $HOME and log) is removed on the way out
         }
     }
-    // Ctrl-C reaches POV-Ray too (same process group) and may end it before we look.
+    // A signal that came as POV-Ray ended by itself.
     if (cancel && cancel->load()) throw Interrupted();
     run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     run.log = read_text(log);

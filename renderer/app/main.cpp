@@ -330,6 +330,7 @@ int run_render(const RenderArguments& args) {
         refuse_symlink_target(args.output);
     };
     if (const int status = exit_on_input_error(args.scene, check_usage); status >= 0) return status;
+    const InputFilesNoted inputs;  // the scene, its meshes and MTL files, as they are read
     api::Expected<api::Scene> read = load_scene_argument(args.scene, args.overrides);
     if (!read) return api::report(read.error());
     loaded.emplace(std::move(read).value());
@@ -350,7 +351,10 @@ int run_render(const RenderArguments& args) {
                 check_output_options(args.output, output);
             }
         }
-        for (const std::string& mesh : scene.mesh_files()) refuse_output_over(args.output, mesh, "mesh file");
+        // Any file the scene read (a mesh, an MTL file an OBJ names), by identity: the same file
+        // under another name or through a link too.
+        if (const std::string input = input_file_at(args.output); !input.empty())
+            throw std::invalid_argument("refusing to write the image to '" + args.output + "': it is " + input);
         if (crop &&
             (int64_t(crop->x) + crop->width > scene.width() || int64_t(crop->y) + crop->height > scene.height()))
             throw std::invalid_argument("--crop " + args.crop + " does not lie inside the " +

@@ -6,6 +6,8 @@ before any work, exit 2, with a message naming the path, and leave every file as
   * `check --report r` where the scene is r/metrics.json, r/scene.pov or r/ours.exr;
   * `convert s.yaml mesh.pov` where mesh.pov is the scene's OBJ mesh, and `convert s.yaml
     out.pov` where the OBJ says `mtllib out.ini` (convert writes the .pov and the .ini);
+  * `render s.yaml -o mtl.png` where the OBJ says `mtllib mtl.png`, and the same through a hard
+    link to that MTL file;
   * `render -o`, `convert` and `colour --write-config` to a symlink to /proc/self/fd/1 while
     standard output is a regular file (the file and the link stay as they were);
   * `convert` into an immutable directory (chattr +i, root only): refused at once, not after
@@ -105,6 +107,19 @@ def main():
             f.write(MESH_SCENE.replace("MESH", "m.obj"))
         refused("convert s3.yaml out.pov (mtllib out.ini)", [whitted, "convert", "s3.yaml", "out.pov"], work,
                 "an input of the same command", ["out.ini", "MTL file"])
+
+        # render: the image is the MTL file an OBJ of the scene names, by its name or another
+        # (a hard link): refused once the scene is read, before the BVH is built.
+        with open(os.path.join(work, "mtl.png"), "w") as f:
+            f.write(MTL)
+        os.link(os.path.join(work, "mtl.png"), os.path.join(work, "hard.png"))
+        with open(os.path.join(work, "m5.obj"), "w") as f:
+            f.write(OBJ.replace("MTL", "mtl.png"))
+        with open(os.path.join(work, "s5.yaml"), "w") as f:
+            f.write(MESH_SCENE.replace("MESH", "m5.obj"))
+        for image in ["mtl.png", "hard.png"]:
+            refused(f"render s5.yaml -o {image} (mtllib mtl.png)", [whitted, "render", "s5.yaml", "-o", image, "-q"],
+                    work, "MTL file", [image, "mtl.png"])
 
         # A symlink to /proc/self/fd/1, standard output a regular file.
         links = os.path.join(d, "links")

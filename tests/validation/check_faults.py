@@ -7,7 +7,9 @@
             regular files. Runs the real POV-Ray (POVRAY, default: povray on PATH).
   signals   SIGTERM to whitted, and SIGINT to its process group (what Ctrl-C sends), while a
             stand-in POV-Ray (fake_povray.py) hangs, once more with one that ignores both
-            signals: whitted exits 143/130 within 5 s, POV-Ray is no longer running, and
+            signals, and once more with one that a wrapper script runs as its child (the
+            script's process group must end, not the script alone): whitted exits 143/130
+            within 5 s, POV-Ray is no longer running, and
             $TMPDIR (private to the test) holds no whitted-check-* or whitted-povray-home-*.
   povray-signals  the same with the real POV-Ray, on a scene it takes many seconds to render.
 Usage: check_faults.py WHITTED symlinks SCENE [--povray POVRAY] | signals | povray-signals"""
@@ -106,7 +108,8 @@ def interrupt(whitted, d, mode, sig, to_group):
     os.mkdir(tmp)
     pidfile = os.path.join(d, f"pid-{mode}-{sig.name}")
     scene = os.path.join(d, "background.yaml")
-    environment = dict(os.environ, TMPDIR=tmp, WHITTED_POVRAY=fake_povray.install(d), FAKE_POVRAY_MODE=mode,
+    povray_program = fake_povray.install(d, as_child=mode == "hang-behind-a-shell")
+    environment = dict(os.environ, TMPDIR=tmp, WHITTED_POVRAY=povray_program, FAKE_POVRAY_MODE=mode,
                        FAKE_POVRAY_PIDFILE=pidfile)
     process = subprocess.Popen([whitted, "check", scene, "-q"], env=environment, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True, start_new_session=True)
@@ -203,6 +206,9 @@ def signals(whitted):
         # A POV-Ray that ignores both: whitted must kill it (SIGKILL after 2 s) and still clean up.
         problems += interrupt(whitted, d, "hang-ignoring-signals", signal.SIGTERM, to_group=False)
         problems += interrupt(whitted, d, "hang-ignoring-signals", signal.SIGINT, to_group=True)
+        # POV-Ray run by a wrapper script as its child: the whole group must end, not the script alone.
+        problems += interrupt(whitted, d, "hang-behind-a-shell", signal.SIGTERM, to_group=False)
+        problems += interrupt(whitted, d, "hang-behind-a-shell", signal.SIGINT, to_group=True)
     return problems
 
 

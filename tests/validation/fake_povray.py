@@ -2,7 +2,8 @@
 """A stand-in for POV-Ray (run through WHITTED_POVRAY) that writes an image with known pixels,
 or hangs, so that `whitted check` can be given exactly the POV-Ray output a test needs.
 Reads Output_File_Name and +W/+H from the .ini it is given. The environment says what to do:
-  FAKE_POVRAY_MODE     image (default) | hang | hang-ignoring-signals
+  FAKE_POVRAY_MODE     image (default) | hang | hang-ignoring-signals | hang-behind-a-shell (hangs;
+                       the test installs it as_child)
   FAKE_POVRAY_CODES    r,g,b: the 16-bit code of every pixel (default 0,0,0)
   FAKE_POVRAY_PIXELS   x,y,channel,code;...: pixels that differ
   FAKE_POVRAY_SIZE     WxH instead of the .ini's size
@@ -20,12 +21,14 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import images  # noqa: E402
 
 
-def install(directory):
+def install(directory, as_child=False):
     """Writes `directory`/povray, which runs this stand-in with the same Python; returns its
-    path, for WHITTED_POVRAY."""
-    wrapper = os.path.join(directory, "povray")
+    path, for WHITTED_POVRAY. With `as_child` the script runs it as its child (no exec), as a
+    wrapper script that does more afterwards would: signalling the script alone leaves it running."""
+    wrapper = os.path.join(directory, "povray-child" if as_child else "povray")
     with open(wrapper, "w") as f:
-        f.write(f"#!/bin/sh\nexec {shlex.quote(sys.executable)} {shlex.quote(os.path.abspath(__file__))} \"$@\"\n")
+        f.write(f"#!/bin/sh\n{'' if as_child else 'exec '}{shlex.quote(sys.executable)} "
+                f"{shlex.quote(os.path.abspath(__file__))} \"$@\"\n")
     os.chmod(wrapper, 0o755)
     return wrapper
 

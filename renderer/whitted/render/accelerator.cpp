@@ -725,7 +725,7 @@ struct Accelerator::Impl {
     /// origin lies beyond about 1.8e19, or on bounds it cannot order; its rays start on the
     /// shapes. So a finite shape reaching beyond ±max_reach is refused, naming the object.
     static constexpr double max_reach = 1e15;
-    void check_reach() const {
+    void check_reach() {
         const auto reach = [](const Vec3& lo, const Vec3& hi) {
             return std::max(
                 {std::fabs(lo.x), std::fabs(lo.y), std::fabs(lo.z), std::fabs(hi.x), std::fabs(hi.y), std::fabs(hi.z)});
@@ -775,6 +775,15 @@ struct Accelerator::Impl {
         const Camera& camera = scene.camera;
         const auto largest = [](const Vec3& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); };
         const double origins = std::max(finite_reach, largest(camera.eye) + largest(camera.right) + largest(camera.up));
+        // A ray starting beyond that (on a plane's far hit, or one from there) is taken up to the
+        // finite shapes before it is traced (intersect, occluded): the rule holds for it too.
+        finite_shapes_reach = finite_reach;
+        rule_origins = origins;
+        const auto transformed = [](const auto& shape) { return bool(shape.object_to_world); };
+        rule_applies = !scene.instances.empty() ||
+                       std::any_of(scene.spheres.begin(), scene.spheres.end(), transformed) ||
+                       std::any_of(scene.boxes.begin(), scene.boxes.end(), transformed) ||
+                       std::any_of(scene.cones.begin(), scene.cones.end(), transformed);
         // How far from the origin of an object's own space the rays start there.
         const auto origins_in_own_space = [&](const Transform& to_world) {
             const double shrink = largest(to_world.inverse_vector({1, 0, 0})) +
@@ -860,6 +869,57 @@ struct Accelerator::Impl {
     }
     /// Where rays may start in a prototype's own space (check_reach): a tenth of Embree's limit.
     static constexpr double max_instance_origin = 1e17;
+    /// check_reach's bounds, each on every axis: every finite shape lies within
+    /// finite_shapes_reach of the origin, and its rule holds for rays starting within rule_origins.
+    double finite_shapes_reach = 0, rule_origins = 0;
+    /// Whether the scene has what the rule is for: an instance, or a sphere, box or cone with a
+    /// transform. Without one, Embree takes the world's rays as they are (a plane's far hits stay
+    /// well within its 1.8e19), and every answer is the double test's on the ray itself.
+    bool rule_applies = false;
+
+    /// Whether `ray` starts where check_reach's rule does not reach: only a plane's far hits
+    /// (up to RaySpans::far_t_max = 1e16 from the eye, and further after bounces between planes)
+    /// and the rays from them start there. Embree takes such an origin in float, and an
+    /// instance or a transformed shape takes it into its own space, however much it shrinks
+    /// there: the shadow ray from a floor's hit 1e11 away gave Embree an origin of 1e19 in the
+    /// space of an instance scaled by 1e-8 (an abort).
+    bool starts_afar(const Ray& ray) const {
+        return rule_applies &&
+               std::max({std::fabs(ray.origin.x), std::fabs(ray.origin.y), std::fabs(ray.origin.z)}) > rule_origins;
+    }
+
+    /// `ray` (starting afar) from where it enters the cube that holds every finite shape: its
+    /// origin moved along it by `skipped`, its range shortened by as much. False when it does not
+    /// meet the cube within its range: no finite shape can be on it. The new origin is put inside
+    /// the cube (its rounding, an ulp of the far origin, is the ray's own uncertainty), so the
+    /// rule bounds it.
+    bool toward_finite_shapes(const Ray& ray, Ray& near, double& skipped) const {
+        const double cube = finite_shapes_reach;
+        double enter = 0, leave = ray.t_max;
+        const double origin[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
+        const double direction[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
+        for (int axis = 0; axis < 3; ++axis) {
+            if (direction[axis] == 0) {
+                if (!(std::fabs(origin[axis]) <= cube)) return false;
+                continue;
+            }
+            double a = (-cube - origin[axis]) / direction[axis], b = (cube - origin[axis]) / direction[axis];
+            if (a > b) std::swap(a, b);
+            enter = std::max(enter, a);
+            leave = std::min(leave, b);
+        }
+        if (!(enter <= leave) || !(leave > ray.t_min)) return false;
+        // A little before the cube, so that a shape on its face is still ahead of `near`.
+        const double margin = 1e-6 * cube, outer = cube + 2 * margin;
+        skipped = std::max(0.0, enter - margin);
+        const Vec3 at = ray.at(skipped);
+        near.origin =
+            Vec3(std::clamp(at.x, -outer, outer), std::clamp(at.y, -outer, outer), std::clamp(at.z, -outer, outer));
+        near.direction = ray.direction;
+        near.t_min = std::max(ray.t_min - enter, 0.0);
+        near.t_max = ray.t_max - enter;
+        return true;
+    }
 
     /// A BVH is built once per triangle and traversed once per ray. HIGH quality took 2.0 s to
     /// build 1M triangles against 0.2 s for MEDIUM, for a few percent faster traversal that a
@@ -1201,9 +1261,32 @@ struct Accelerator::Impl {
 
     /// The nearest hit on `ray`: Embree's nearest candidate, when the double test accepts it.
     bool intersect(const Ray& ray, SurfaceHit& out) const {
+        return starts_afar(ray) ? intersect_from_afar(ray, out) : intersect_from_here(ray, out);
+    }
+
+    /// intersect for a ray that does not start afar (or has been brought near).
+    bool intersect_from_here(const Ray& ray, SurfaceHit& out) const {
         bool retry = false;
         const bool found = trace(ray, nullptr, out, retry);
         return retry ? intersect_again(ray, out) : found;
+    }
+
+    /// intersect for a ray that starts_afar: a plane it meets before it reaches the finite
+    /// shapes' cube, else what it meets from there on (toward_finite_shapes).
+    bool intersect_from_afar(const Ray& ray, SurfaceHit& out) const {
+        Ray near;
+        double skipped = 0;
+        bool retry = false;
+        if (!toward_finite_shapes(ray, near, skipped))
+            return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, {}, false, out, retry);
+        Ray before = ray;
+        before.t_max = std::min(ray.t_max, skipped);
+        if (before.t_max > before.t_min &&
+            finish_hit(before, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, {}, false, out, retry))
+            return true;
+        if (!intersect_from_here(near, out)) return false;
+        out.t += skipped;
+        return true;
     }
 
     /// The nearest hit on a ray whose nearest candidate the double test refused (finish_hit):
@@ -1295,6 +1378,9 @@ struct Accelerator::Impl {
     }
 
     void intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found) const {
+        bool from_here[packet_size];
+        active = without_rays_from_afar(rays, active, count, from_here,
+                                        [&](int i) { found[i] = intersect_from_afar(rays[i], hits[i]); });
         // One ray (a refracted path) goes through Embree's single-ray traversal: a W-wide packet
         // with one lane in use walks the same nodes at W lanes' cost.
         if (count == 1) {
@@ -1324,8 +1410,34 @@ struct Accelerator::Impl {
     /// once per blocked ray. With exact_range the meshes carry the filter themselves.
     RTCFilterFunctionN shadow_filter() const { return frame.exact_range ? nullptr : triangle_filter; }
 
+    /// `active`, unless some of those rays starts_afar: each of them is answered by `alone(i)`
+    /// and the others' flags copied to `kept`, which is returned. Only rays from a plane's far
+    /// hits take that path; every other ray's packet is the same.
+    template <class Alone>
+    const bool* without_rays_from_afar(const Ray* rays, const bool* active, int count, bool* kept,
+                                       Alone&& alone) const {
+        bool any = false;
+        for (int i = 0; i < count; ++i) any |= active[i] && starts_afar(rays[i]);
+        if (!any) return active;
+        for (int i = 0; i < count; ++i) {
+            kept[i] = active[i] && !starts_afar(rays[i]);
+            if (active[i] && !kept[i]) alone(i);
+        }
+        return kept;
+    }
+
     bool occluded(const Ray& ray) const {
         if (occluded_by_plane(ray)) return true;
+        if (starts_afar(ray)) {
+            Ray near;
+            double skipped = 0;
+            return toward_finite_shapes(ray, near, skipped) && near.t_max > near.t_min && occluded_in_bvh(near);
+        }
+        return occluded_in_bvh(ray);
+    }
+
+    /// Embree's answer for a shadow ray, the planes aside.
+    bool occluded_in_bvh(const Ray& ray) const {
         QueryContext context(&ray, nullptr, 1, false);
         context.embree.filter = shadow_filter();
         RTCRay r = make_embree_ray(ray, 0, frame);
@@ -1357,6 +1469,8 @@ struct Accelerator::Impl {
     }
 
     void occluded_packet(const Ray* rays, const bool* active, int count, bool* blocked) const {
+        bool from_here[packet_size];
+        active = without_rays_from_afar(rays, active, count, from_here, [&](int i) { blocked[i] = occluded(rays[i]); });
         if (count == 1) {  // one ray, as in intersect_packet
             if (active[0]) blocked[0] = occluded(rays[0]);
             embree_error.throw_if_failed("while tracing shadow rays");
