@@ -7,7 +7,7 @@ unlike bench/generate.py (other shapes, transforms, JSON with indentation) as a 
 made elsewhere. At its pixel (254, 237) a mirror ray starts 4e-5 above a turned box's top
 (nearer than the 1e-4 a ray must travel), crosses that box and leaves it through its bottom, in
 the floor's plane: Whitted gave that bottom the hit and POV-Ray the floor, 1,147 codes apart,
-until a plane took such a tie (accelerator.cpp, finish_hit). Coordinates keep 7 decimals, or
+until a plane took such a tie (accelerator_exact.cpp, finish_hit). Coordinates keep 7 decimals, or
 DECIMALS: with 3 (written as random_boxes_3.json), overlapping boxes share faces, met at exactly
 the same t, and Whitted must show the box POV-Ray shows (PovrayTestOrder; seed 1 failed the cap
 by 14,831 codes before, docs/validation.md, Known differences). The scene asks for POV-Ray's

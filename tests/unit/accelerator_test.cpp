@@ -396,7 +396,7 @@ std::vector<Ray> rays_at_edges(const std::vector<Vec3>& vertices, const std::vec
 }
 
 // Embree proposes every triangle the double test accepts: it is given the triangles widened
-// beyond its float rounding (accelerator.cpp, widen_triangles), and what it proposes is decided
+// beyond its float rounding (accelerator_build.cpp, widen_triangles), and what it proposes is decided
 // in double. The reference is a brute-force search of every triangle: the nearest one that
 // the test of the mesh's kind accepts. Near the origin that is POV-Ray's mesh2 test
 // (intersect_mesh2_triangle); at x ≥ 16, where the converter writes the mesh about its own

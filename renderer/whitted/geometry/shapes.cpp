@@ -6,6 +6,50 @@
 
 namespace whitted {
 
+namespace {
+
+/// Vertex `index`'s normal as the mesh stores it (float), in double.
+Vec3 vertex_normal(const TriangleMesh& mesh, uint32_t index) {
+    const float* n = &mesh.normals[3 * size_t(index)];
+    return {n[0], n[1], n[2]};
+}
+
+/// Whether the normals n0, n1, n2 of a triangle are one normal, within rounding.
+bool one_normal(const Vec3& n0, const Vec3& n1, const Vec3& n2) {
+    const Vec3 d1 = n0 - n1, d2 = n0 - n2;
+    return dot(d1, d1) <= 1e-10 && dot(d2, d2) <= 1e-10;
+}
+
+}  // namespace
+
+bool shaded_smooth(const TriangleMesh& mesh, uint32_t prim, Convention convention) {
+    if (mesh.normals.empty()) return false;
+    const uint32_t* index = &mesh.indices[3 * size_t(prim)];
+    return convention == Convention::course ||
+           !one_normal(vertex_normal(mesh, index[0]), vertex_normal(mesh, index[1]), vertex_normal(mesh, index[2]));
+}
+
+bool blended_normal(const TriangleMesh& mesh, uint32_t prim, double u, double v, Convention convention, Vec3& out) {
+    if (mesh.normals.empty()) return false;
+    const uint32_t* index = &mesh.indices[3 * size_t(prim)];
+    const Vec3 n0 = vertex_normal(mesh, index[0]), n1 = vertex_normal(mesh, index[1]),
+               n2 = vertex_normal(mesh, index[2]);
+    if (convention != Convention::course && one_normal(n0, n1, n2)) return false;
+    const Vec3 blended = n0 * (1.0 - u - v) + n1 * u + n2 * v;
+    const double len = length(blended);
+    if (!(len > 0)) return false;
+    out = blended / len;
+    return true;
+}
+
+uint32_t triangle_material(const TriangleMesh& mesh, uint32_t prim) {
+    return mesh.triangle_materials.empty() ? mesh.material : mesh.triangle_materials[prim];
+}
+
+uint32_t triangle_material(const Instance& instance, const TriangleMesh& mesh, uint32_t prim) {
+    return instance.material != Instance::no_material ? instance.material : triangle_material(mesh, prim);
+}
+
 Ray to_object_space(const Transform& to_world, const Ray& ray) {
     if (to_world.is_identity()) return ray;
     return {to_world.inverse_point(ray.origin), to_world.inverse_vector(ray.direction), ray.t_min, ray.t_max};

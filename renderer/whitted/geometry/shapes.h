@@ -39,6 +39,22 @@ bool intersect_plane(const Plane& plane, const Ray& ray, double t_min, double t_
 /// rounding, which the exact test alone does not promise.
 bool intersect_triangle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Ray& ray, double t_min, double t_max,
                         ShapeHit& hit, double edge_margin = 0);
+
+/// Whether triangle `prim` is shaded smooth, with its vertex normals blended, rather than flat
+/// with its face normal: its mesh has vertex normals and its three are not one normal (under
+/// render.convention: course they are blended always, as the course's ray tracer does).
+bool shaded_smooth(const TriangleMesh& mesh, uint32_t prim, Convention convention);
+/// The smooth shading normal at a hit on triangle `prim` with barycentric weights u, v
+/// (ShapeHit): the unit vertex normals blended by weight, n0 (1 − u − v) + n1 u + n2 v, and made
+/// unit length, as the lecture and POV-Ray's mesh2 do. False where the triangle is shaded flat
+/// (shaded_smooth) or the blend has length 0: its face normal then shades it.
+bool blended_normal(const TriangleMesh& mesh, uint32_t prim, double u, double v, Convention convention, Vec3& out);
+/// The material of triangle `prim`: its own where the mesh has one per triangle, else the mesh's.
+uint32_t triangle_material(const TriangleMesh& mesh, uint32_t prim);
+/// The same for a prototype's triangle placed by `instance`, whose material, if it has one,
+/// overrides the prototype's.
+uint32_t triangle_material(const Instance& instance, const TriangleMesh& mesh, uint32_t prim);
+
 /// World-space bounds of a sphere, box or cone (its object-space box pushed through the transform).
 void world_bounds(const Sphere& sphere, Vec3& lo, Vec3& hi);
 void world_bounds(const Box& box, Vec3& lo, Vec3& hi);

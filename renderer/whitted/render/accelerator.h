@@ -2,6 +2,7 @@
 #pragma once
 
 #include "whitted/core/ray.h"
+#include "whitted/render/accelerator_device.h"
 #include "whitted/scene/scene.h"
 
 #include <memory>
@@ -9,27 +10,6 @@
 #include <vector>
 
 namespace whitted {
-
-/// Embree's instruction sets, narrowest first, by the names of Embree's `isa=` setting. Embree
-/// picks the widest the CPU has; forcing a narrower one (WHITTED_EMBREE_ISA) lets the tests run,
-/// on one machine, the code paths that users' CPUs take (docs/building.md).
-const std::vector<std::string>& embree_isa_names();
-/// $WHITTED_EMBREE_ISA: "" when unset or empty (Embree chooses). Throws std::invalid_argument,
-/// naming the choices, when it is none of embree_isa_names().
-std::string embree_isa_from_environment();
-/// Throws std::invalid_argument, saying so, when Embree cannot run `isa` on this CPU ("" always
-/// can): an Embree device is made with it and released, so a bad setting is found before any work.
-void require_embree_isa(const std::string& isa);
-bool embree_isa_supported(const std::string& isa);
-
-/// What `whitted --version` reports of Embree.
-struct EmbreeInfo {
-    std::string version;            ///< e.g. "3.13.5"
-    std::vector<std::string> isas;  ///< of embree_isa_names(), those this CPU can run
-    std::string isa_in_use;         ///< the one asked for, else the widest of `isas`
-    int lane_width = 1;             ///< Accelerator::lane_width() with it
-};
-EmbreeInfo embree_info(const std::string& isa);
 
 /// What a ray hit, in double precision.
 struct SurfaceHit {

@@ -662,7 +662,7 @@ void make_window_camera(const CameraDescription& d, const Vec3& forward, Camera&
 
 Camera make_camera(const CameraDescription& d, int width, int height) {
     // Rays start at the eye (or across an orthographic view), and Embree, in float, stops the
-    // program on a ray beyond about 1.8e19: refused with the scene's own range (accelerator.cpp).
+    // program on a ray beyond about 1.8e19: refused with the scene's own range (accelerator_frame.cpp).
     constexpr double max_reach = 1e15;
     const auto far = [](const Vec3& v) {
         return !(std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}) <= max_reach);

@@ -129,4 +129,45 @@ MeshAsPovray::MeshAsPovray(const TriangleMesh& mesh, Intersection rule) : decide
                       });
 }
 
+bool MeshAsPovray::smooth_normal(const TriangleMesh& mesh, uint32_t prim, const Vec3& point, Convention convention,
+                                 Vec3& out) const {
+    if (!shaded_smooth(mesh, prim, convention)) return false;
+    const uint32_t* index = &mesh.indices[3 * size_t(prim)];
+    const auto as_read = [&](uint32_t i) {
+        const float* n = &normals[3 * size_t(i)];
+        return Vec3(n[0], n[1], n[2]);
+    };
+    const Vec3 blended =
+        mesh2_smooth_normal(mesh.offset(index[0]), mesh.offset(index[1]), mesh.offset(index[2]), as_read(index[0]),
+                            as_read(index[1]), as_read(index[2]), point - mesh.origin);
+    const double len = length(blended);
+    if (!(len > 0)) return false;
+    out = blended / len;
+    return true;
+}
+
+bool intersect_mesh2(const TriangleMesh& mesh, uint32_t prim, const Ray& ray, bool instanced, ShapeHit& hit) {
+    const uint32_t* index = &mesh.indices[3 * size_t(prim)];
+    const Vec3 p0 = mesh.offset(index[0]), p1 = mesh.offset(index[1]), p2 = mesh.offset(index[2]);
+    const Vec3 origin = ray.origin - mesh.origin;
+    double t = 0;
+    bool inside = false;
+    if (instanced) {
+        const Vec3& d = ray.direction;
+        const double len = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+        const double inverse = 1.0 / len;
+        if (!intersect_mesh2_triangle(p0, p1, p2, origin, {d.x * inverse, d.y * inverse, d.z * inverse}, t, inside))
+            return false;
+        t /= len;
+    } else if (!intersect_mesh2_triangle(p0, p1, p2, origin, ray.direction, t, inside)) {
+        return false;
+    }
+    if (!inside || !(t > ray.t_min && t < ray.t_max)) return false;
+    const Vec3 v0 = mesh.vertex(index[0]), v1 = mesh.vertex(index[1]), v2 = mesh.vertex(index[2]);
+    hit.t = t;
+    hit.u = hit.v = 0;
+    hit.normal = cross(v1 - v0, v2 - v0);
+    return true;
+}
+
 }  // namespace whitted

@@ -8,6 +8,7 @@
 // POV-Ray's source (triangle.cpp, mesh.cpp, parse.cpp); the code is Whitted's own.
 
 #include "whitted/core/vec3.h"
+#include "whitted/geometry/shapes.h"
 #include "whitted/scene/scene.h"
 
 #include <vector>
@@ -35,6 +36,18 @@ bool intersect_mesh2_triangle(const Vec3& p1, const Vec3& p2, const Vec3& p3, co
 Vec3 mesh2_smooth_normal(const Vec3& p1, const Vec3& p2, const Vec3& p3, const Vec3& n1, const Vec3& n2, const Vec3& n3,
                          const Vec3& point);
 
+/// Triangle `prim` of `mesh` tested as POV-Ray tests the converter's mesh2 (render.intersection:
+/// povray): intersect_mesh2_triangle on the float offsets from the mesh's origin, with the ray
+/// moved by −origin in double (the mesh2's `translate`), hit where it lies inside and within
+/// (ray.t_min, ray.t_max). For a prototype's triangle (`instanced`) the ray is in the
+/// prototype's space with the world's t, and POV-Ray makes its direction unit length first.
+/// It differs from the exact test where a ray grazes a triangle (the single-precision plane
+/// moves the hit along the ray by up to 5e-3, past the shadow window) or passes within about
+/// 1e-9 of an edge (the float planes of two neighbours can leave a crack between them, or
+/// overlap): docs/pov-model.md §3, "Mesh triangles". hit.normal is (v1 − v0) × (v2 − v0); u and
+/// v are 0, POV-Ray's smooth normal being computed from the point (MeshAsPovray::smooth_normal).
+bool intersect_mesh2(const TriangleMesh& mesh, uint32_t prim, const Ray& ray, bool instanced, ShapeHit& hit);
+
 /// Whether a mesh is decided as POV-Ray decides it (the accelerator's hit_triangle_in_double)
 /// and, if so, its vertex normals as POV-Ray holds them: made unit length again as they are
 /// read, then stored as floats (POV-Ray's parse.cpp). Computed once, not at each hit.
@@ -43,6 +56,13 @@ struct MeshAsPovray {
     std::vector<float> normals;  ///< 3 per vertex; empty unless decided and the mesh has normals
 
     MeshAsPovray(const TriangleMesh& mesh, Intersection rule);
+
+    /// POV-Ray's smooth normal of triangle `prim` at `point`, the hit in the mesh's space, from
+    /// the normals as held here (mesh2_smooth_normal), made unit length. False where the
+    /// triangle is shaded flat (shaded_smooth) or the blend has length 0. Only for a mesh
+    /// `decided`.
+    bool smooth_normal(const TriangleMesh& mesh, uint32_t prim, const Vec3& point, Convention convention,
+                       Vec3& out) const;
 };
 
 }  // namespace whitted

@@ -94,6 +94,20 @@ private:
     uint32_t m_root = 0;
 };
 
+/// Under POV-Ray's rules, a sphere or box met at exactly the t of the sphere or box held, the
+/// two looking different (another material or normal): whether the candidate takes the held
+/// one's place. A plain face at the same t replaces a face the edge rule chose
+/// (ShapeHit::edge_tie: a ray along one box's edge, inside another's top), POV-Ray then testing
+/// the other box first, its bounding box being met earlier (bench/generate.py --boxes 1000000,
+/// row 383). Where that is the only difference (one material) the rule decides; otherwise
+/// `order_decides` is set, and PovrayTestOrder says which shows (the accelerator's finish_hit).
+/// Building that order costs a million equal cubes 0.6 s, which ties of one material whose
+/// faces differ only by the edge rule need not pay.
+inline bool povray_tie_replaces(bool same_material, bool held_edge_tie, bool candidate_edge_tie, bool& order_decides) {
+    if (!(same_material && candidate_edge_tie != held_edge_tie)) order_decides = true;
+    return held_edge_tie && !candidate_edge_tie;
+}
+
 /// The two radius-0 spheres `whitted convert` places at a box's corners so that POV-Ray's
 /// single-precision bounding box of the union holds the whole box (pov_writer.cpp): the world
 /// bounds pushed out by 8 to 16 floats' spacing.
