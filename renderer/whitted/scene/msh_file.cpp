@@ -43,11 +43,12 @@ private:
     int m_line = 1, m_column = 1;
 };
 
-/// A word of the file as a message quotes it: escaped (a terminal never sees its control
-/// characters) and short, since a number is what was expected (a .msh that is a link to another
-/// file should not print that file's first line).
+/// A word of the file as a message names it: quoted and escaped (a terminal never sees its
+/// control characters) when it is short enough to be a mistyped number or section name, else by
+/// its length only, so that a .msh that is a link to another file (/etc/passwd) shows none of it.
 std::string shown(std::string_view word) {
-    return printable(word, 16);
+    if (word.size() > 12) return "a word of " + std::to_string(word.size()) + " bytes";
+    return "'" + printable(word, 12) + "'";
 }
 
 double read_number(Words& words, const std::string& what) {
@@ -59,10 +60,10 @@ double read_number(Words& words, const std::string& what) {
     double value = 0;
     const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
     if (error == std::errc::result_out_of_range)
-        throw InputError(where, what + ": '" + shown(word) + "' is out of range");
+        throw InputError(where, what + ": " + shown(word) + " is out of range");
     if (error != std::errc() || end != digits.data() + digits.size() || !std::isfinite(value))
-        throw InputError(where, what + ": expected a number, got '" + shown(word) + "'");
-    if (std::fabs(value) > 3.4e38) throw InputError(where, what + ": '" + shown(word) + "' is beyond float range");
+        throw InputError(where, what + ": expected a number, got " + shown(word));
+    if (std::fabs(value) > 3.4e38) throw InputError(where, what + ": " + shown(word) + " is beyond float range");
     return value;
 }
 
@@ -73,7 +74,7 @@ int64_t read_count(Words& words, const std::string& what, int64_t limit) {
     int64_t value = -1;
     const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), value);
     if (error != std::errc() || end != word.data() + word.size() || value < 0)
-        throw InputError(where, what + ": expected a whole number ≥ 0, got '" + shown(word) + "'");
+        throw InputError(where, what + ": expected a whole number ≥ 0, got " + shown(word));
     if (value > limit)
         throw InputError(where,
                          what + ": " + std::to_string(value) + " is more than the limit of " + std::to_string(limit));
@@ -120,7 +121,7 @@ MeshData load_msh_mesh(const std::string& path, const SourceLocation& referenced
                 int64_t index = -1;
                 const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), index);
                 if (error != std::errc() || end != word.data() + word.size())
-                    throw InputError(at, what + ": expected a vertex index, got '" + shown(word) + "'");
+                    throw InputError(at, what + ": expected a vertex index, got " + shown(word));
                 if (index < 0 || index >= vertex_count)
                     throw InputError(at, what + ": vertex index " + std::to_string(index) + " is out of range (0.." +
                                              std::to_string(vertex_count - 1) + ")");
@@ -137,7 +138,7 @@ MeshData load_msh_mesh(const std::string& path, const SourceLocation& referenced
                 read_number(words, "texture coordinate " + std::to_string(i / 2));
         } else {
             throw InputError(
-                where, "unknown section '" + shown(section) + "'; expected vertices, triangles, normals or texcoords");
+                where, "unknown section " + shown(section) + "; expected vertices, triangles, normals or texcoords");
         }
     }
     if (!seen_vertices) throw InputError(words.here(), "the file has no 'vertices' section");
