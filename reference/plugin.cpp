@@ -3,9 +3,9 @@
 // Its entry points are looked up by name with dlsym; both sides are built together by the same
 // compiler, so they pass C++ types.
 
-#include "api/errors.h"
 #include "reference/check.h"
 #include "reference/file_colour.h"
+#include "whitted/scene/errors.h"
 #include "whitted/scene/source_location.h"
 #include "whitted/scene/text_checks.h"
 #include "whitted/whitted.h"

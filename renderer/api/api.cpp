@@ -3,7 +3,6 @@
 // turned into an Error value here, with the location an InputError carries.
 
 #include "api/api_internal.h"
-#include "api/errors.h"
 #include "converters/pov_writer.h"
 #include "reference/check.h"
 #include "whitted/core/plugin.h"
@@ -11,6 +10,7 @@
 #include "whitted/render/distributed.h"
 #include "whitted/render/layers.h"
 #include "whitted/render/renderer.h"
+#include "whitted/scene/errors.h"
 #include "whitted/scene/text_checks.h"
 
 #include <algorithm>
@@ -38,7 +38,7 @@ Error plain_error(std::string message, Error::Kind kind) {
     return error;
 }
 
-/// Runs `work`, turning what it throws into an Error (api/errors.h); `what` finishes "out of
+/// Runs `work`, turning what it throws into an Error (whitted/scene/errors.h); `what` finishes "out of
 /// memory while ...".
 template <class T, class Work>
 Expected<T> guarded(const std::string& what, Work&& work) {

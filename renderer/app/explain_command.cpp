@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: MIT
 #include "explain_command.h"
 
-#include "api/errors.h"
 #include "whitted/render/accelerator.h"
 #include "whitted/render/explain.h"
 #include "whitted/scene/description.h"
+#include "whitted/scene/errors.h"
 #include "whitted/scene/scene.h"
 #include "whitted/scene/source_location.h"
 #include "whitted/scene/text_checks.h"

@@ -8,11 +8,11 @@
 #include "live_command.h"
 
 #include "api/api_internal.h"
-#include "api/errors.h"
 #include "converters/yaml_writer.h"
 #include "explain_command.h"
 #include "live_page_html.h"
 #include "whitted/scene/description.h"
+#include "whitted/scene/errors.h"
 #include "whitted/scene/scene.h"
 #include "whitted/whitted.h"
 

@@ -4,7 +4,6 @@
 // (0 ok, 1 failure while rendering or checking, 2 bad input or usage, 130/143 interrupted).
 
 #include "api/api_internal.h"
-#include "api/errors.h"
 #include "converters/pov_writer.h"
 #include "converters/yaml_writer.h"
 #include "explain_command.h"
@@ -18,6 +17,7 @@
 #include "whitted/render/distributed.h"
 #include "whitted/render/renderer.h"
 #include "whitted/scene/description.h"
+#include "whitted/scene/errors.h"
 #include "whitted/scene/scene.h"
 #include "whitted/scene/text_checks.h"
 #include "whitted/whitted.h"

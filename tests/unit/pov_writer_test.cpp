@@ -129,8 +129,8 @@ TEST(PovWriter, FarMeshWrittenAboutItsOwnCentreWithTheFloatOffsetsWhittedStores)
 // Vertex normals are written as the floats Whitted holds (the unit normal rounded to float), so
 // that POV-Ray, which makes each normal it reads unit length again and stores it as a float,
 // ends with the normals Whitted's emulation of it (compat/povray/mesh2.cpp,
-// MeshAsPovray::smooth_normal) starts from. The rounding is real: GCC 12's vectoriser once dropped it, and x and y of these
-// normals were written unrounded (vec3.h, float_rounded).
+// MeshAsPovray::smooth_normal) starts from. The rounding is real: GCC 12's vectoriser once dropped it, and x and y of
+// these normals were written unrounded (vec3.h, float_rounded).
 TEST(PovWriter, NormalsAreWrittenAsFloats) {
     const std::string sdl = sdl_for(
         "objects:\n  - {type: mesh, material: {kd: 0.5}, triangles: [[0, 1, 2]], "

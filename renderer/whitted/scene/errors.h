@@ -4,7 +4,9 @@
 // The one mapping from what the private libraries throw to an api::Error, and from an Error to
 // `whitted`'s exit status. The library (api.cpp), the OpenImageIO plug-in (reference/plugin.cpp)
 // and every command of the program use it, so a kind of mistake means the same status everywhere.
-// Inline: the plug-in is a module of its own and does not link the API library.
+// Inline: the plug-in is a module of its own and does not link the API library. It lives with the
+// scene, where InputError and FileChangedWhileRead are defined, below both the API and the
+// reference tools that use it.
 
 #include "whitted/scene/source_location.h"
 #include "whitted/scene/text_checks.h"
