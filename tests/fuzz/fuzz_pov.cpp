@@ -23,15 +23,14 @@ namespace {
 
 const std::set<std::string>& sdl_keywords() {
     static const std::set<std::string> words{
-        "adc_bailout",   "ambient",       "ambient_light",   "angle",           "assumed_gamma", "background",
-        "box",           "brilliance",    "camera",          "color",           "diffuse",       "face_indices",
-        "finish",        "global_lights", "global_settings", "inside_vector",   "light_group",   "light_source",
-        "location",      "look_at",       "matrix",          "max_trace_level", "mesh2",         "normal_vectors",
-        "object",        "off",           "orthographic",    "parallel",        "perspective",   "phong",
-        "phong_size",    "pigment",       "plane",           "point_at",        "reflection",    "rgb",
-        "rgbf",          "rgbt",          "right",           "roughness",       "sky",           "specular",
-        "sphere",        "split_union",   "texture",         "translate",       "union",         "up",
-        "vertex_vectors"};
+        "adc_bailout", "ambient", "ambient_light", "angle", "assumed_gamma", "background", "box", "brilliance",
+        "camera", "color", "diffuse", "face_indices", "finish", "global_lights", "global_settings", "inside_vector",
+        "light_group", "light_source", "location", "look_at", "matrix", "max_trace_level", "mesh2", "normal_vectors",
+        "object", "off", "orthographic", "parallel", "perspective", "phong", "phong_size", "pigment", "plane",
+        "point_at", "reflection", "rgb", "rgbf", "rgbt", "right", "roughness", "sky", "specular", "sphere",
+        "split_union", "texture", "translate", "union", "up", "vertex_vectors",
+        // Cylinders and cones (`open` for an uncapped one), and glass: the refracting interior.
+        "cone", "cylinder", "open", "interior", "ior"};
     return words;
 }
 
