@@ -43,21 +43,22 @@ def run(command, expect=0, timeout=600, **kwargs):
 
 
 class Failures:
-    """Collects failed checks so that one run reports all of them, then ends the test."""
+    """Collects failed checks so that one run reports all of them: each check prints its verdict
+    ("ok" or "FAIL" and the message), and finish() ends the test, failed if any check did."""
 
     def __init__(self):
         self.messages = []
 
     def check(self, condition, message):
+        print(("ok    " if condition else "FAIL  ") + message)
         if not condition:
             self.messages.append(message)
-        return condition
+        return bool(condition)
 
-    def finish(self, passed_message=None):
+    def finish(self):
         if self.messages:
-            sys.exit("FAIL:\n  " + "\n  ".join(self.messages))
-        if passed_message:
-            print(passed_message)
+            print(f"{len(self.messages)} problem(s)")
+            sys.exit(1)
         sys.exit(0)
 
 

@@ -13,16 +13,15 @@ import signal
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures  # noqa: E402  (tests/harness.py)
+
+
 whitted, work = sys.argv[1:3]
 shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
-problems = []
-
-
-def check(ok, message):
-    print(("ok    " if ok else "FAIL  ") + message)
-    if not ok:
-        problems.append(message)
+failures = Failures()
+check = failures.check
 
 
 bad = os.path.join(work, "bad.yaml")
@@ -54,7 +53,4 @@ server.send_signal(signal.SIGINT)
 code = server.wait(timeout=30)
 check(code == 130, f"SIGINT: exit {code}")
 
-if problems:
-    print(f"{len(problems)} problem(s)")
-    sys.exit(1)
-print("all checks passed")
+failures.finish()

@@ -13,17 +13,16 @@ import shutil
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures  # noqa: E402  (tests/harness.py)
+
+
 whitted, work = sys.argv[1:3]
 shutil.rmtree(work, ignore_errors=True)
 empty = os.path.join(work, "no-plugins")
 os.makedirs(empty)
-problems = []
-
-
-def check(ok, message):
-    print(("ok    " if ok else "FAIL  ") + message)
-    if not ok:
-        problems.append(message)
+failures = Failures()
+check = failures.check
 
 
 linked = subprocess.run([whitted], env={**os.environ, "LD_TRACE_LOADED_OBJECTS": "1"}, capture_output=True,
@@ -58,4 +57,4 @@ r = subprocess.run([whitted, "live", scene, "--no-open"], env=no_plugins, captur
 check(r.returncode == 2 and "libwhitted_live.so" in r.stderr and r.stdout == "",
       f"live with no plug-in: exit {r.returncode}, {r.stderr.strip()!r}")
 
-sys.exit(1 if problems else 0)
+failures.finish()
