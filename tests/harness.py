@@ -11,11 +11,16 @@ anything else failed. Images are read here, byte by byte, rather than through Wh
 code, so a test's reference never depends on the code under test.
 """
 
+import os
+import shutil
 import struct
 import subprocess
 import sys
 
 SKIP = 77
+# What the sanitizers (the ASan/UBSan build) print: a test that sees one has found a fault even
+# when the exit status is the expected one.
+SANITIZER_MARKERS = ("ERROR: AddressSanitizer", "ERROR: LeakSanitizer", "runtime error:", "UndefinedBehaviorSanitizer")
 
 
 def fail(message):
@@ -29,17 +34,37 @@ def skip(reason):
     sys.exit(SKIP)
 
 
-def run(command, expect=0, timeout=600, **kwargs):
-    """Runs COMMAND (a list) with its output captured as text; fails the test unless it exits
-    with EXPECT. Returns the CompletedProcess. KWARGS go to subprocess.run (cwd, env, input)."""
+def run(command, expect=0, timeout=600, text=True, **kwargs):
+    """Runs COMMAND (a list) with its output captured (as text unless TEXT is false); fails the
+    test if it runs past TIMEOUT seconds or, unless EXPECT is None, exits with any status but
+    EXPECT. Returns the CompletedProcess. KWARGS go to subprocess.run (cwd, env, input, stdin,
+    errors; stdout or stderr replace the capture of that stream)."""
+    kwargs.setdefault("stdout", subprocess.PIPE)
+    kwargs.setdefault("stderr", subprocess.PIPE)
     try:
-        result = subprocess.run(command, capture_output=True, text=True, timeout=timeout, **kwargs)
+        result = subprocess.run(command, text=text, timeout=timeout, **kwargs)
     except subprocess.TimeoutExpired:
         fail(f"{' '.join(map(str, command))} ran past {timeout} s")
-    if result.returncode != expect:
+    if expect is not None and result.returncode != expect:
         fail(f"{' '.join(map(str, command))} exited {result.returncode}, expected {expect}\n"
-             f"{result.stderr[-3000:]}")
+             f"{_tail(result.stdout, 2000)}{_tail(result.stderr)}")
     return result
+
+
+def _tail(stream, size=3000):
+    if stream is None:
+        return ""
+    if isinstance(stream, bytes):
+        stream = stream.decode("utf-8", "replace")
+    return stream[-size:]
+
+
+def fresh_folder(path):
+    """Empties PATH, a test's own work folder, and makes it again (with its parents): nothing a
+    previous run left there can be read as this run's output. Returns PATH."""
+    shutil.rmtree(path, ignore_errors=True)
+    os.makedirs(path)
+    return path
 
 
 class Failures:
@@ -55,11 +80,60 @@ class Failures:
             self.messages.append(message)
         return bool(condition)
 
-    def finish(self):
+    def fail(self, message):
+        """Records a failed check without ending the test."""
+        self.check(False, message)
+
+    def require(self, condition, problem):
+        """Records PROBLEM (a sentence saying what went wrong) as a failed check unless
+        CONDITION holds; a check that holds prints nothing."""
+        if not condition:
+            self.fail(problem)
+        return bool(condition)
+
+    def run(self, command, expect=0, timeout=600, **kwargs):
+        """harness.run, but an exit status other than EXPECT is recorded as a failed check and
+        the test goes on (EXPECT None: any status); the CompletedProcess is returned either way."""
+        result = run(command, expect=None, timeout=timeout, **kwargs)
+        if expect is not None and result.returncode != expect:
+            self.fail(f"{' '.join(map(str, command))} exited {result.returncode}, expected {expect}\n"
+                      f"{_tail(result.stderr)}")
+        return result
+
+    def refused(self, what, command, fragments, expect=2, timeout=600, **kwargs):
+        """Runs COMMAND, which must refuse: a failed check unless it exits with EXPECT and its
+        standard error holds every one of FRAGMENTS. Returns the CompletedProcess."""
+        result = run(command, expect=None, timeout=timeout, **kwargs)
+        stderr = _tail(result.stderr)
+        self.require(result.returncode == expect, f"{what}: exit {result.returncode}, expected {expect}\n{stderr}")
+        for fragment in fragments:
+            self.require(fragment in stderr, f"{what}: the message does not say '{fragment}': {stderr!r}")
+        return result
+
+    def finish(self, passed=None):
+        """Ends the test: failed (exit 1) if any check failed, else passed, printing PASSED."""
         if self.messages:
             print(f"{len(self.messages)} problem(s)")
             sys.exit(1)
+        if passed:
+            print(passed)
         sys.exit(0)
+
+
+def read_pixels(path, with_names=False):
+    """The pixels of any image file OpenImageIO reads, as a height x width x channels float
+    array (and the channel names, WITH_NAMES); fails the test if it cannot be opened. For images
+    that are only compared with each other or with a closed form; read_exr reads Whitted's EXR
+    files without a library."""
+    import OpenImageIO as oiio
+
+    image = oiio.ImageInput.open(str(path))
+    if image is None:
+        fail(f"OpenImageIO cannot open {path}: {oiio.geterror()}")
+    names = list(image.spec().channelnames)
+    pixels = image.read_image(format="float")
+    image.close()
+    return (pixels, names) if with_names else pixels
 
 
 def read_exr_header(data, path="image"):

@@ -10,11 +10,11 @@ what a user relies on when the input is wrong:
 Usage: run_case.py WHITTED CASES_DIR SCENE_FILE WORK_DIR"""
 
 import os
-import shutil
-import subprocess
 import sys
 
-SANITIZER_MARKERS = ("ERROR: AddressSanitizer", "ERROR: LeakSanitizer", "runtime error:", "UndefinedBehaviorSanitizer")
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import SANITIZER_MARKERS, Failures, fail, fresh_folder, run  # noqa: E402  (tests/harness.py)
+
 OLD_BYTES = b"previous output: must survive a failed render\n" * 64
 
 
@@ -27,14 +27,13 @@ def load_case(cases_dir, scene):
             name, code, fragment = (part.strip() for part in line.split("|", 2))
             if name == scene:
                 return int(code), fragment
-    sys.exit(f"run_case: {scene} is not listed in cases.txt")
+    fail(f"{scene} is not listed in cases.txt")
 
 
 def main():
     whitted, cases_dir, scene, work = sys.argv[1:5]
     expected_code, fragment = load_case(cases_dir, scene)
-    shutil.rmtree(work, ignore_errors=True)
-    os.makedirs(work)
+    fresh_folder(work)
     output = os.path.join(work, "OUT.exr")
     with open(output, "wb") as f:
         f.write(OLD_BYTES)
@@ -42,37 +41,27 @@ def main():
     # A huge allocation must become an error message, not a sanitizer abort.
     env["ASAN_OPTIONS"] = env.get("ASAN_OPTIONS", "detect_leaks=1") + ":allocator_may_return_null=1"
     command = [whitted, "render", os.path.join(cases_dir, scene), "-o", output, "-t", "1", "-q"]
-    try:
-        result = subprocess.run(command, capture_output=True, timeout=60, env=env)
-    except subprocess.TimeoutExpired:
-        sys.exit(f"FAIL {scene}: no answer within 60 s")
+    result = run(command, expect=None, timeout=60, text=False, env=env)
     stderr = result.stderr.decode("utf-8", "replace")
-    problems = []
+    print(f"{scene}: exit {result.returncode}: {stderr.strip()[:300]}")
+    failures = Failures()
     if result.returncode < 0:
-        problems.append(f"killed by signal {-result.returncode}")
-    elif result.returncode != expected_code:
-        problems.append(f"exit code {result.returncode}, expected {expected_code}")
-    if fragment not in stderr:
-        problems.append(f"stderr lacks '{fragment}'")
-    if scene not in stderr:
-        problems.append(f"stderr does not name the scene file '{scene}'")
+        failures.fail(f"killed by signal {-result.returncode}")
+    else:
+        failures.check(result.returncode == expected_code, f"exit code {result.returncode}, expected {expected_code}")
+    failures.check(fragment in stderr, f"stderr holds '{fragment}'")
+    failures.check(scene in stderr, f"stderr names the scene file '{scene}'")
     raw = sorted({hex(b) for b in result.stderr if b < 0x20 and b != 0x0A})
-    if raw:
-        problems.append(f"stderr holds raw control characters {raw}")
+    failures.check(not raw, f"stderr holds no raw control characters {raw}")
     for marker in SANITIZER_MARKERS:
-        if marker in stderr:
-            problems.append(f"sanitizer report ({marker})")
+        failures.check(marker not in stderr, f"no sanitizer report ({marker})")
     with open(output, "rb") as f:
-        if f.read() != OLD_BYTES:
-            problems.append("the existing output was changed")
+        failures.check(f.read() == OLD_BYTES, "the existing output is unchanged")
     leftovers = sorted(set(os.listdir(work)) - {"OUT.exr"})
-    if leftovers:
-        problems.append(f"files left behind: {leftovers}")
-    if problems:
-        print(f"FAIL {scene}: " + "; ".join(problems))
+    failures.check(not leftovers, f"no files left behind {leftovers}")
+    if failures.messages:
         print("--- stderr ---\n" + stderr[-4000:])
-        sys.exit(1)
-    print(f"ok {scene}: exit {result.returncode}: {stderr.strip()[:300]}")
+    failures.finish()
 
 
 if __name__ == "__main__":

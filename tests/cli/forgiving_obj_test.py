@@ -8,17 +8,16 @@ of an undefined material get the default material (kd 0.6 grey: equal channels w
 Usage: forgiving_obj_test.py WHITTED CASES_DIR WORK_DIR
 """
 import os
-import shutil
-import subprocess
 import sys
 
 import numpy as np
-import OpenImageIO as oiio
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, fresh_folder, read_pixels  # noqa: E402  (tests/harness.py)
 
 whitted, cases, work = sys.argv[1:4]
-shutil.rmtree(work, ignore_errors=True)
-os.makedirs(work)
-failures = []
+fresh_folder(work)
+failures = Failures()
 
 expected = {
     "mtl_missing_file.yaml": "mtl_missing_file.obj:5:8: material 'red' is not defined: the MTL file "
@@ -28,23 +27,18 @@ expected = {
 }
 for scene, fragment in expected.items():
     output = os.path.join(work, scene.replace(".yaml", ".exr"))
-    result = subprocess.run([whitted, "render", os.path.join(cases, scene), "-q", "-o", output],
-                            capture_output=True, text=True)
+    result = failures.run([whitted, "render", os.path.join(cases, scene), "-q", "-o", output])
     if result.returncode != 0:
-        failures.append(f"{scene}: exit {result.returncode}: {result.stderr}")
         continue
-    if f"whitted: warning: " not in result.stderr or fragment not in result.stderr:
-        failures.append(f"{scene}: the warning lacks '{fragment}': {result.stderr!r}")
+    failures.check("whitted: warning: " in result.stderr and fragment in result.stderr,
+                   f"{scene}: the warning says '{fragment}': {result.stderr!r}")
     if scene == "mtl_kd_before_newmtl.yaml":
         continue  # its face has material x, which the MTL file defines (without the Kd before it)
-    image = oiio.ImageInput.open(output).read_image(format="float")
+    image = read_pixels(output)
     # The triangle (0,0,0) (1,0,0) (0,1,0) faces the camera on +z; what covers the image centre
     # region's lower left is lit by the scene's light at n.l > 0: a grey pixel (r = g = b > 0).
     lit = image[np.all(image > 0, axis=-1)]
-    if len(lit) == 0 or not np.all(np.isclose(lit[:, 0], lit[:, 1])) or not np.all(np.isclose(lit[:, 1], lit[:, 2])):
-        failures.append(f"{scene}: the faces are not drawn in the grey default material")
+    failures.check(len(lit) > 0 and np.all(np.isclose(lit[:, 0], lit[:, 1])) and np.all(np.isclose(lit[:, 1], lit[:, 2])),
+                   f"{scene}: the faces are drawn in the grey default material")
 
-if failures:
-    print("FAIL:\n" + "\n".join(failures))
-    sys.exit(1)
-print("PASS: undefined materials, missing MTL files and statements before newmtl render with a warning")
+failures.finish("PASS: undefined materials, missing MTL files and statements before newmtl render with a warning")

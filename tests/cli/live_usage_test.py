@@ -8,18 +8,16 @@ usage: live_usage_test.py WHITTED WORK_DIR
 """
 import os
 import re
-import shutil
 import signal
 import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from harness import Failures  # noqa: E402  (tests/harness.py)
+from harness import Failures, fresh_folder  # noqa: E402  (tests/harness.py)
 
 
 whitted, work = sys.argv[1:3]
-shutil.rmtree(work, ignore_errors=True)
-os.makedirs(work)
+fresh_folder(work)
 failures = Failures()
 check = failures.check
 

@@ -14,41 +14,30 @@ an override from the same scene with the value written into the file.
 Usage: overrides_test.py WHITTED SOURCE_DIR WORK_DIR
 """
 import os
-import shutil
-import subprocess
 import sys
 
 import numpy as np
 import OpenImageIO as oiio
 import yaml
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, fresh_folder, read_pixels  # noqa: E402  (tests/harness.py)
+
 whitted, source, work = sys.argv[1:4]
-shutil.rmtree(work, ignore_errors=True)
-os.makedirs(work)
-failures = []
+fresh_folder(work)
+failures = Failures()
 
 
 def run(args, expect=0, stdin=None):
-    result = subprocess.run([whitted, *args], capture_output=True, cwd=work, input=stdin)
-    if result.returncode != expect:
-        failures.append(f"{' '.join(args)}: exit {result.returncode}, expected {expect}\n"
-                        f"{result.stderr.decode(errors='replace')}")
-    return result
+    """whitted ARGS in the work folder, its output as bytes."""
+    return failures.run([whitted, *args], expect, cwd=work, input=stdin, text=False)
 
 
 def read_exr(name):
-    image = oiio.ImageInput.open(os.path.join(work, name))
-    if image is None:
-        failures.append(f"cannot read {name}: {oiio.geterror()}")
-        return np.zeros((0, 0, 3), np.float32)
-    pixels = image.read_image(format="float")
-    image.close()
-    return pixels
+    return read_pixels(os.path.join(work, name))
 
 
-def check(condition, message):
-    if not condition:
-        failures.append(message)
+check = failures.require
 
 
 # A small lecture scene with a mirror (depth matters), rendered at an odd size.
@@ -232,7 +221,7 @@ try:
     check("Gr\ufffdn" in json.dumps(explained, ensure_ascii=False),
           "explain --json: the Latin-1 name is not written as U+FFFD")
 except ValueError as e:
-    failures.append(f"explain --json with a Latin-1 material name is not JSON: {e}")
+    failures.fail(f"explain --json with a Latin-1 material name is not JSON: {e}")
 
 # --- radiance past the largest float -----------------------------------------------------------------
 # A colour of 1e258 (a fuzzer's find): the pixels are +inf in the EXR, and the render says so.
@@ -252,15 +241,12 @@ import resource
 with open(os.path.join(work, "limited.exr"), "wb") as f:
     f.write(b"previous image")
 before = set(os.listdir(work))
-limited = subprocess.run([whitted, "render", base, "-q", "-o", "limited.exr"], capture_output=True, cwd=work,
-                         preexec_fn=lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (4096, 4096)))
+limited = failures.run([whitted, "render", base, "-q", "-o", "limited.exr"], expect=1, cwd=work, text=False,
+                       preexec_fn=lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (4096, 4096)))
 check(limited.returncode == 1 and b"File too large" in limited.stderr,
       f"ulimit -f: exit {limited.returncode}, {limited.stderr!r}")
 with open(os.path.join(work, "limited.exr"), "rb") as f:
     check(f.read() == b"previous image", "ulimit -f: the previous output changed")
 check(set(os.listdir(work)) == before, f"ulimit -f: files left: {set(os.listdir(work)) - before}")
 
-if failures:
-    print("FAIL:\n" + "\n".join(failures))
-    sys.exit(1)
-print("PASS: overrides, crop, standard input, usage errors, suggestions")
+failures.finish("PASS: overrides, crop, standard input, usage errors, suggestions")

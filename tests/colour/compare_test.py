@@ -9,18 +9,23 @@ function (a view of a config of our own with a square-root curve) is refused wit
 
 Usage: compare_test.py WHITTED EXAMPLES_DIR"""
 import os
-import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, run  # noqa: E402  (tests/harness.py)
+
 whitted, examples = sys.argv[1], sys.argv[2]
-failures = []
+failures = Failures()
 env = dict(os.environ)
 env.pop("OCIO", None)
 
 
-def run(args, cwd):
-    return subprocess.run([whitted] + args, cwd=cwd, env=env, capture_output=True, text=True, timeout=120)
+def whitted_in(work, args, expect=0):
+    """whitted ARGS in WORK, without $OCIO; an exit status but EXPECT (None: any) is a failure."""
+    if expect is None:
+        return run([whitted] + args, None, timeout=120, cwd=work, env=env)
+    return failures.run([whitted] + args, expect, timeout=120, cwd=work, env=env)
 
 
 # A display with a square-root curve: a plain power law, but none Whitted recognises.
@@ -43,8 +48,7 @@ colorspaces:
 
 with tempfile.TemporaryDirectory() as work:
     scene = os.path.join(examples, "lecture", "09-glazed-floor.yaml")
-    if run(["render", scene, "-q", "-o", "linear.exr"], work).returncode != 0:
-        sys.exit("FAIL cannot render the EXR")
+    run([whitted, "render", scene, "-q", "-o", "linear.exr"], timeout=120, cwd=work, env=env)
     # file, extra options, tolerance in 16-bit codes: half an 8-bit code times the largest slope of
     # the decoding (2.4 for the 2.4 power law; P3's matrix adds up to 1.45 times that), or 3
     # 16-bit codes in a 16-bit file (half a code of rounding times the slope, and OCIO's own).
@@ -65,40 +69,31 @@ with tempfile.TemporaryDirectory() as work:
         fraction = str(rest[0] if rest else 1)
         # Where every pixel must be within the tolerance, the cap on any one pixel is the same.
         cap = str(rest[1] if len(rest) > 1 else max(tolerance, 64))
-        result = run(["render", scene, "-q", "-o", name] + options, work)
-        if result.returncode != 0:
-            failures.append(f"{name}: render failed: {result.stderr.strip()}")
+        if whitted_in(work, ["render", scene, "-q", "-o", name] + options).returncode != 0:
             continue
-        result = run(["compare", "linear.exr", name, "--clip", "--tolerance", str(tolerance), "--min-fraction", fraction,
-                      "--max-error", cap], work)
+        result = whitted_in(work, ["compare", "linear.exr", name, "--clip", "--tolerance", str(tolerance),
+                                   "--min-fraction", fraction, "--max-error", cap])
         out = result.stdout
         if result.returncode != 0:
-            failures.append(f"{name}: compare exit {result.returncode}:\n{out}{result.stderr}")
+            print(out)
         elif "linear.exr: linear, Rec.709 primaries" not in out or "used as it is" not in out:
-            failures.append(f"{name}: compare does not say the EXR is used as it is:\n{out}")
+            failures.fail(f"{name}: compare does not say the EXR is used as it is:\n{out}")
         elif not any(line.startswith(f"{name}: ") and line.endswith(
                 "used as it is" if "Raw" in options else "converted to linear Rec.709") for line in out.splitlines()):
-            failures.append(f"{name}: compare does not say what it did with the file:\n{out}")
+            failures.fail(f"{name}: compare does not say what it did with the file:\n{out}")
         else:
             print(f"ok   {name}: {out.strip().splitlines()[-1]}")
         # Tighter than the file's quantisation allows must fail: the tolerance above is earned.
-        tight = run(["compare", "linear.exr", name, "--clip", "--tolerance", str(tolerance / 8), "--min-fraction",
-                     fraction, "--max-error", cap], work)
-        if tight.returncode != 1:
-            failures.append(f"{name}: at a tolerance of {tolerance / 8} codes compare exits {tight.returncode}, not 1")
+        whitted_in(work, ["compare", "linear.exr", name, "--clip", "--tolerance", str(tolerance / 8), "--min-fraction",
+                          fraction, "--max-error", cap], expect=1)
 
     with open(os.path.join(work, "root.ocio"), "w") as f:
         f.write(SQRT_CONFIG)
-    result = run(["render", scene, "-q", "-o", "root.png", "--ocio-config", "root.ocio"], work)
-    if result.returncode != 0:
-        failures.append(f"root.png: render with the square-root config failed: {result.stderr.strip()}")
-    else:
-        result = run(["compare", "linear.exr", "root.png"], work)
+    if whitted_in(work, ["render", scene, "-q", "-o", "root.png", "--ocio-config", "root.ocio"]).returncode == 0:
+        result = whitted_in(work, ["compare", "linear.exr", "root.png"], expect=None)
         if result.returncode != 2 or "whitted: error: cannot compare 'root.png'" not in result.stderr:
-            failures.append(f"root.png: compare exit {result.returncode}, not 2 with a reason: {result.stderr.strip()}")
+            failures.fail(f"root.png: compare exit {result.returncode}, not 2 with a reason: {result.stderr.strip()}")
         else:
             print(f"ok   root.png refused: {result.stderr.strip()}")
 
-for failure in failures:
-    print("FAIL " + failure)
-sys.exit(1 if failures else 0)
+failures.finish()

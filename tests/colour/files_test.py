@@ -21,36 +21,31 @@ import io
 import json
 import os
 import shutil
-import subprocess
 import sys
 import tempfile
 
 import yaml
 from PIL import Image, ImageCms
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, fail, run as run_program  # noqa: E402  (tests/harness.py)
+
 whitted, examples = sys.argv[1], sys.argv[2]
 # The version is written once, in CMake; `whitted --version` reports it ("whitted X.Y.Z" first).
-software = "Whitted " + subprocess.run([whitted, "--version"], capture_output=True, text=True,
-                                       check=True).stdout.split()[1]
-failures = []
+software = "Whitted " + run_program([whitted, "--version"]).stdout.split()[1]
+failures = Failures()
 env = dict(os.environ)
 env.pop("OCIO", None)
 
 
-def check(condition, message):
-    if not condition:
-        failures.append(message)
-    return condition
+check = failures.require
 
 
 def run(args, cwd):
-    for tool in (args[0],):
-        if not shutil.which(tool) and not os.path.isfile(tool):
-            sys.exit(f"FAIL {tool} is not installed (scripts/setup --with-test-tools installs it)")
-    result = subprocess.run(args, cwd=cwd, env=env, capture_output=True, text=True, timeout=120)
-    if result.returncode != 0:
-        failures.append(f"{' '.join(args)}: exit {result.returncode}: {result.stderr.strip()}")
-    return result
+    """ARGS in CWD without $OCIO; a tool that is not installed fails the test (not a skip)."""
+    if not shutil.which(args[0]) and not os.path.isfile(args[0]):
+        fail(f"{args[0]} is not installed (scripts/setup --with-test-tools installs it)")
+    return failures.run(args, timeout=120, cwd=cwd, env=env)
 
 
 def oiio_info(path, cwd):
@@ -234,7 +229,4 @@ with tempfile.TemporaryDirectory() as work:
     left = [n for n in os.listdir(work) if ".whitted-" in n]
     check(not left, f"temporary files left: {left}")
 
-for failure in failures:
-    print("FAIL " + failure)
-print(f"{'FAIL' if failures else 'ok'}: {len(failures)} problem(s)")
-sys.exit(1 if failures else 0)
+failures.finish("ok: 0 problem(s)")

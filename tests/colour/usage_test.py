@@ -11,13 +11,15 @@ loaded machine: it did once, at 14 s, beside a front-door build, 2026-12-03).
 Usage: usage_test.py WHITTED EXAMPLES_DIR"""
 import os
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, run as run_program  # noqa: E402  (tests/harness.py)
+
 whitted, examples = sys.argv[1], sys.argv[2]
-failures = []
+failures = Failures()
 
 
 def run(args, cwd):
@@ -27,7 +29,7 @@ def run(args, cwd):
     # The best of three, so that a loaded machine (ctest -j) does not make a fast check look slow.
     for _ in range(3):
         start = time.monotonic()
-        result = subprocess.run([whitted] + args, cwd=cwd, env=env, capture_output=True, text=True, timeout=60)
+        result = run_program([whitted] + args, expect=None, timeout=60, cwd=cwd, env=env)
         elapsed = time.monotonic() - start
         best = elapsed if best is None else min(best, elapsed)
     return result, best
@@ -47,7 +49,7 @@ def expect_usage_error(args, cwd, fragments, label):
         if fragment not in result.stderr:
             problems.append(f"message lacks {fragment!r}")
     if problems:
-        failures.append(f"{label}: {'; '.join(problems)}\n    stderr: {result.stderr.strip()}")
+        failures.fail(f"{label}: {'; '.join(problems)}\n    stderr: {result.stderr.strip()}")
     else:
         print(f"ok   {label}: exit 2 in {seconds * 1000:.0f} ms (start-up {START_UP * 1000:.0f} ms): "
               f"{result.stderr.strip()[:110]}")
@@ -87,37 +89,28 @@ with tempfile.TemporaryDirectory() as work:
     before = open(scene, "rb").read()
     for output in ["s.png", "./s.png", os.path.join(work, "s.png"), "link.png"]:
         expect_usage_error(["render", "s.png", "-o", output], work, ["it is the scene file"], f"-o {output} (the scene)")
-    if open(scene, "rb").read() != before:
-        failures.append("the scene file was changed")
+    failures.require(open(scene, "rb").read() == before, "the scene file was changed")
 
     # The output is one of the scene's mesh files (a hard link to it: the same file).
     meshes = os.path.join(work, "meshes")
     shutil.copytree(os.path.join(examples, "meshes"), meshes)
     os.link(os.path.join(meshes, "octahedron.obj"), os.path.join(meshes, "out.png"))
     result, _ = run(["render", "meshes.yaml", "-o", "out.png"], meshes)
-    if result.returncode != 2 or "it is the mesh file" not in result.stderr:
-        failures.append(f"output over a mesh file: exit {result.returncode}: {result.stderr.strip()}")
-    else:
-        print(f"ok   output over a mesh file: {result.stderr.strip()}")
+    failures.check(result.returncode == 2 and "it is the mesh file" in result.stderr,
+                   f"output over a mesh file: exit {result.returncode}: {result.stderr.strip()}")
 
     # A legal 240-byte name renders (its temporary name is longer than 255 bytes uncut).
     long_name = "y" * 236 + ".png"
     result, _ = run(["render", "s.png", "-q", "-o", long_name], work)
-    if result.returncode != 0 or not os.path.isfile(os.path.join(work, long_name)):
-        failures.append(f"a 240-byte output name: exit {result.returncode}: {result.stderr.strip()}")
-    else:
-        print("ok   a 240-byte output name renders")
+    failures.check(result.returncode == 0 and os.path.isfile(os.path.join(work, long_name)),
+                   f"a 240-byte output name renders: exit {result.returncode}: {result.stderr.strip()}")
     leftovers = [n for n in os.listdir(work) if ".whitted-" in n]
-    if leftovers:
-        failures.append(f"temporary files left: {leftovers}")
+    failures.require(not leftovers, f"temporary files left: {leftovers}")
     for name in ["a.jpg", "a.jpeg", "a.png", "a.tif", "a.exr", "a.webp"]:
-        if os.path.exists(os.path.join(work, name)):
-            failures.append(f"{name} was written by a refused command")
+        failures.require(not os.path.exists(os.path.join(work, name)), f"{name} was written by a refused command")
 
     # `whitted colour` refuses what it cannot do, in the same way.
     expect_usage_error(["colour", "--list", "--ocio-config", "/etc/passwd"], work, ["/etc/passwd"], "colour --list bad config")
     expect_usage_error(["colour", "--ocio-config", "x.ocio"], work, ["--ocio-config goes with --list"], "colour no --list")
 
-for failure in failures:
-    print("FAIL " + failure)
-sys.exit(1 if failures else 0)
+failures.finish()

@@ -9,12 +9,14 @@ Usage: write_failure_test.py WHITTED EXAMPLES_DIR"""
 import os
 import resource
 import signal
-import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, run  # noqa: E402  (tests/harness.py)
+
 whitted, examples = sys.argv[1], sys.argv[2]
-failures = []
+failures = Failures()
 scene = os.path.join(examples, "lecture", "09-glazed-floor.yaml")
 LIMIT = 4000  # bytes: every format's 640x480 image of the scene is larger (the JPEG, 7.5 kB)
 
@@ -29,8 +31,8 @@ with tempfile.TemporaryDirectory() as work:
         path = os.path.join(work, name)
         with open(path, "wb") as f:
             f.write(b"the previous image")
-        result = subprocess.run([whitted, "render", scene, "-q", "-o", name], cwd=work, capture_output=True,
-                                text=True, timeout=120, preexec_fn=limited)
+        result = run([whitted, "render", scene, "-q", "-o", name], expect=None, timeout=120, cwd=work,
+                     preexec_fn=limited)
         problems = []
         if result.returncode != 1:
             problems.append(f"exit {result.returncode}, not 1")
@@ -42,11 +44,6 @@ with tempfile.TemporaryDirectory() as work:
         left = [n for n in os.listdir(work) if ".whitted-" in n]
         if left:
             problems.append(f"temporary files left: {left}")
-        if problems:
-            failures.append(f"{name}: {'; '.join(problems)}\n    stderr: {result.stderr.strip()}")
-        else:
-            print(f"ok   {name}: {lines[0]}")
+        failures.check(not problems, f"{name}: {'; '.join(problems) or lines[0]}\n    stderr: {result.stderr.strip()}")
 
-for failure in failures:
-    print("FAIL " + failure)
-sys.exit(1 if failures else 0)
+failures.finish()

@@ -21,12 +21,11 @@ The linear EXR is read back here (32-bit floats, exact)."""
 
 import math
 import os
-import shutil
 import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from harness import SKIP, read_exr, run  # noqa: E402  (tests/harness.py)
+from harness import SKIP, fresh_folder, read_exr, run  # noqa: E402  (tests/harness.py)
 
 
 def render_floats(whitted, scene, work, name):
@@ -201,8 +200,7 @@ def pov_refuses(whitted, scenes_dir, scene, work):
 
 def main():
     mode, whitted, directory, scene, work = sys.argv[1:6]
-    shutil.rmtree(work, ignore_errors=True)
-    os.makedirs(work)
+    fresh_folder(work)
     modes = {"corpus": corpus, "course_image": course_image, "closed": closed, "same": same,
              "pov_refuses": pov_refuses}
     return modes[mode](whitted, directory, scene, work)

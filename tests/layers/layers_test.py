@@ -29,23 +29,17 @@ import re
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from harness import run  # noqa: E402  (tests/harness.py)
+from harness import read_pixels, run  # noqa: E402  (tests/harness.py)
 
 import numpy as np
-import OpenImageIO as oiio
 
 COLOUR_TERMS = ["ambient", "diffuse", "specular", "mirror", "transmission", "background"]
 
 
 def read_exr(path):
     """{channel name: HxW float32 array}, read with OpenImageIO."""
-    image = oiio.ImageInput.open(path)
-    if image is None:
-        sys.exit(f"FAIL: OpenImageIO cannot open {path}: {oiio.geterror()}")
-    spec = image.spec()
-    pixels = image.read_image(format="float")  # H x W x C
-    image.close()
-    return {name: pixels[:, :, c].astype(np.float32) for c, name in enumerate(spec.channelnames)}
+    pixels, names = read_pixels(path, with_names=True)
+    return {name: pixels[:, :, c].astype(np.float32) for c, name in enumerate(names)}
 
 
 def layer(channels, name):

@@ -14,17 +14,15 @@ The linear EXR is read back by tests/course/course_test.py's reader (32-bit floa
 
 import json
 import os
-import shutil
 import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from harness import SKIP, read_exr, run  # noqa: E402  (tests/harness.py)
+from harness import SKIP, fresh_folder, read_exr, run  # noqa: E402  (tests/harness.py)
 
 
 def fresh(work):
-    shutil.rmtree(work, ignore_errors=True)
-    os.makedirs(work)
+    fresh_folder(work)
 
 
 def same(whitted, scene, work):

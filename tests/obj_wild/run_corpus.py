@@ -20,10 +20,12 @@ Usage: run_corpus.py WHITTED CORPUS_DIR TABLE WORK_DIR"""
 import os
 import re
 import shutil
-import subprocess
 import sys
 
 from PIL import Image
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, fail, fresh_folder, run  # noqa: E402  (tests/harness.py)
 
 SIZE = 96  # silhouette images: SIZE x SIZE pixels, one sample each
 # Pixels whose coverage may differ between the two triangulations of the same polygons: rays
@@ -45,19 +47,19 @@ def read_table(path):
                 continue
             fields = [field.strip() for field in line.split("|")]
             if len(fields) != 4:
-                sys.exit(f"{path}:{number}: expected 4 fields separated by '|', got {len(fields)}")
+                fail(f"{path}:{number}: expected 4 fields separated by '|', got {len(fields)}")
             name, assimp, outcome, detail = fields
             if name in table:
-                sys.exit(f"{path}:{number}: {name} is listed twice")
+                fail(f"{path}:{number}: {name} is listed twice")
             if outcome not in ("renders", "refused"):
-                sys.exit(f"{path}:{number}: outcome must be 'renders' or 'refused', got '{outcome}'")
+                fail(f"{path}:{number}: outcome must be 'renders' or 'refused', got '{outcome}'")
             table[name] = {"assimp": assimp, "outcome": outcome, "detail": detail, "line": number}
     return table
 
 
 def assimp_info(path):
     """(accepted, faces of triangle meshes, (min, max) corners) from `assimp info`."""
-    result = subprocess.run(["assimp", "info", path], capture_output=True, text=True, errors="replace", timeout=120)
+    result = run(["assimp", "info", path], expect=None, timeout=120, errors="replace")
     out = result.stdout + result.stderr
     if result.returncode != 0 or "ERROR" in out:
         return False, None, None
@@ -120,9 +122,9 @@ def views(corners):
 
 
 def render(whitted, scene_path, image_path):
-    result = subprocess.run([whitted, "render", scene_path, "-o", image_path, "--stats", "-q", "-t", "2"],
-                            capture_output=True, timeout=300)
-    return result.returncode, result.stderr.decode("utf-8", "replace")
+    result = run([whitted, "render", scene_path, "-o", image_path, "--stats", "-q", "-t", "2"], expect=None,
+                 timeout=300, errors="replace")
+    return result.returncode, result.stderr
 
 
 def covered(image_path):
@@ -132,30 +134,29 @@ def covered(image_path):
 
 def main():
     whitted, corpus, table_path, work = sys.argv[1:5]
-    problems = []
+    problems = Failures()
     if not os.path.isdir(corpus):
-        sys.exit(f"FAIL: {corpus} is missing: install assimp-testmodels (scripts/setup --with-test-tools)")
+        fail(f"{corpus} is missing: install assimp-testmodels (scripts/setup --with-test-tools)")
     if not shutil.which("assimp"):
-        sys.exit("FAIL: the assimp command is missing: install assimp-utils (scripts/setup --with-test-tools)")
+        fail("the assimp command is missing: install assimp-utils (scripts/setup --with-test-tools)")
     table = read_table(table_path)
     files = sorted(os.path.relpath(os.path.join(d, f), corpus)
                    for d, _, names in os.walk(corpus) for f in names if f.lower().endswith(".obj"))
     for name in sorted(set(table) - set(files)):
-        problems.append(f"{name}: in the table (line {table[name]['line']}) but not in {corpus}")
-    shutil.rmtree(work, ignore_errors=True)
-    os.makedirs(work)
+        problems.fail(f"{name}: in the table (line {table[name]['line']}) but not in {corpus}")
+    fresh_folder(work)
     counts = {"renders": 0, "refused": 0}
     for name in files:
         path = os.path.join(corpus, name)
         if name not in table:
-            problems.append(f"{name}: a new OBJ file, not in {table_path}")
+            problems.fail(f"{name}: a new OBJ file, not in {table_path}")
             continue
         expect = table[name]
         base = os.path.join(work, name.replace("/", "_"))
         accepted, assimp_triangles, corners = assimp_info(path)
         seen_assimp = str(assimp_triangles) if accepted else "rejects"
         if seen_assimp != expect["assimp"]:
-            problems.append(f"{name}: assimp info gives {seen_assimp}, the table says {expect['assimp']}")
+            problems.fail(f"{name}: assimp info gives {seen_assimp}, the table says {expect['assimp']}")
 
         # As a user would load it: MTL materials, or the default material.
         eye, look_at = [3.0, 2.0, 5.0], [0.0, 0.0, 0.0]
@@ -169,20 +170,20 @@ def main():
         if expect["outcome"] == "refused":
             counts["refused"] += 1
             if code != 2:
-                problems.append(f"{name}: exit code {code}, expected 2 (refused: {expect['detail']})")
+                problems.fail(f"{name}: exit code {code}, expected 2 (refused: {expect['detail']})")
             elif expect["detail"] not in stderr:
-                problems.append(f"{name}: the message lacks '{expect['detail']}': {stderr.strip()}")
+                problems.fail(f"{name}: the message lacks '{expect['detail']}': {stderr.strip()}")
             elif not LOCATION.search(stderr):
-                problems.append(f"{name}: the message names no FILE:LINE:COL: {stderr.strip()}")
+                problems.fail(f"{name}: the message names no FILE:LINE:COL: {stderr.strip()}")
             else:
                 print(f"ok {name}: refused: {stderr.strip().splitlines()[-1]}")
             continue
         counts["renders"] += 1
         if code != 0 or not triangles:
-            problems.append(f"{name}: exit code {code}, expected a render: {stderr.strip()}")
+            problems.fail(f"{name}: exit code {code}, expected a render: {stderr.strip()}")
             continue
         if triangles.group(1) != expect["detail"]:
-            problems.append(f"{name}: {triangles.group(1)} triangles, the table says {expect['detail']}")
+            problems.fail(f"{name}: {triangles.group(1)} triangles, the table says {expect['detail']}")
             continue
         if not accepted:
             print(f"ok {name}: renders, {plural(triangles.group(1), 'triangle')} (Assimp rejects it)")
@@ -190,15 +191,13 @@ def main():
 
         # Assimp's own triangulation of the same file, as triangles only.
         export = base + ".assimp.obj"
-        result = subprocess.run(["assimp", "export", path, export, "-fobjnomtl", "-tri"], capture_output=True,
-                                timeout=120)
-        if result.returncode != 0:
-            problems.append(f"{name}: assimp export failed ({result.returncode})")
+        if problems.run(["assimp", "export", path, export, "-fobjnomtl", "-tri"], timeout=120,
+                        errors="replace").returncode != 0:
             continue
         with open(export, "rb") as f:
             exported = sum(1 for line in f if line.startswith(b"f "))
         if str(exported) != expect["detail"]:
-            problems.append(f"{name}: Assimp's triangulation has {exported} triangles, Whitted's {expect['detail']}")
+            problems.fail(f"{name}: Assimp's triangulation has {exported} triangles, Whitted's {expect['detail']}")
             continue
         _, cameras = views(corners)
         differences = []
@@ -210,7 +209,7 @@ def main():
                     f.write(scene_text(mesh, "{ ka: 1 }", camera, look_at))
                 code, stderr = render(whitted, scene, scene[:-5] + ".png")
                 if code != 0:
-                    problems.append(f"{name}: silhouette render of {label} failed: {stderr.strip()}")
+                    problems.fail(f"{name}: silhouette render of {label} failed: {stderr.strip()}")
                     break
                 masks.append(covered(scene[:-5] + ".png"))
             if len(masks) != 2:
@@ -218,19 +217,17 @@ def main():
             different = sum(a != b for a, b in zip(*masks))
             differences.append(different)
             if sum(masks[0]) == 0:
-                problems.append(f"{name}: view {v} shows nothing of the mesh")
+                problems.fail(f"{name}: view {v} shows nothing of the mesh")
             if different > MAX_SILHOUETTE_DIFFERENCE:
-                problems.append(f"{name}: view {v}: {different} pixels covered by one triangulation only "
+                problems.fail(f"{name}: view {v}: {different} pixels covered by one triangulation only "
                                 f"(at most {MAX_SILHOUETTE_DIFFERENCE}); see {base}.view{v}.*.png")
         print(f"ok {name}: renders, {plural(triangles.group(1), 'triangle')} (assimp info: {expect['assimp']} in "
               f"triangle meshes); pixels covered by only one of Whitted's and Assimp's triangulations, per view: "
               f"{differences}")
-    for problem in problems:
-        print("FAIL " + problem)
     print(f"obj_wild: {len(files)} OBJ files: {counts['renders']} render, {counts['refused']} refused; "
-          f"{len(problems)} mismatches")
-    return 1 if problems else 0
+          f"{len(problems.messages)} mismatches")
+    problems.finish()
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

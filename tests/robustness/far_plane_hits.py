@@ -18,8 +18,10 @@ and `explain` of it gives 0. The control, the same wall moved 100 to the side, l
 Usage: far_plane_hits.py WHITTED WORK_DIR"""
 import json
 import os
-import subprocess
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, run  # noqa: E402  (tests/harness.py)
 
 SCENE = """version: 1
 camera: { eye: [0, 1, 6], look_at: [0, 0.99999999994, 0], fov: 45 }
@@ -46,18 +48,16 @@ CENTRE = "4,4,1,1"  # the middle pixel: its ray runs along x = 0
 def main():
     whitted, work = os.path.abspath(sys.argv[1]), sys.argv[2]
     os.makedirs(work, exist_ok=True)
-    failures = []
+    failures = Failures()
 
-    def run(*args):
-        return subprocess.run([whitted, *args], capture_output=True, text=True, timeout=120)
+    def whitted_run(*args, expect=0):
+        return failures.run([whitted, *args], expect, timeout=120)
 
     black_scene = os.path.join(work, "black.yaml")
     with open(black_scene, "w") as f:
         f.write(SCENE.split("prototypes:")[0] + "objects: []\n")
     black = os.path.join(work, "black.exr")
-    result = run("render", black_scene, "-o", black, "--crop", CENTRE, "-q")
-    if result.returncode != 0:
-        sys.exit(f"the black reference does not render: {result.stderr}")
+    run([whitted, "render", black_scene, "-o", black, "--crop", CENTRE, "-q"], timeout=120)
 
     for what, wall in WALLS.items():
         for shift, shadowed in (("0", True), ("100", False)):
@@ -66,26 +66,21 @@ def main():
             with open(scene, "w") as f:
                 f.write(SCENE + wall.replace("SHIFT", shift))
             image = os.path.join(work, name + ".exr")
-            result = run("render", scene, "-o", image, "--crop", CENTRE, "-q")
-            if result.returncode != 0:
-                failures.append(f"{what}, moved by {shift}: render exit {result.returncode}\n{result.stderr[-600:]}")
+            if whitted_run("render", scene, "-o", image, "--crop", CENTRE, "-q").returncode != 0:
                 continue
-            same = run("compare", image, black, "--tolerance", "0").returncode == 0
+            same = run([whitted, "compare", image, black, "--tolerance", "0"], expect=None, timeout=120).returncode == 0
             if same != shadowed:
-                failures.append(f"{what}, moved by {shift}: the pixel is {'black' if same else 'lit'}, expected "
+                failures.fail(f"{what}, moved by {shift}: the pixel is {'black' if same else 'lit'}, expected "
                                 f"{'black (the wall hides the light)' if shadowed else 'lit'}")
-            explained = run("explain", scene, "--pixel", "4,4", "--json")
+            explained = whitted_run("explain", scene, "--pixel", "4,4", "--json")
             if explained.returncode != 0:
-                failures.append(f"{what}, moved by {shift}: explain exit {explained.returncode}\n{explained.stderr}")
                 continue
             pixel = json.loads(explained.stdout)["pixel"]
             if (max(pixel) == 0) != shadowed:
-                failures.append(f"{what}, moved by {shift}: explain gives {pixel}")
+                failures.fail(f"{what}, moved by {shift}: explain gives {pixel}")
             print(f"{what}, moved by {shift}: the pixel is {'black' if same else 'lit'}, explain {pixel[0]:g}")
-    for failure in failures:
-        print("FAIL", failure)
-    return 1 if failures else 0
+    failures.finish()
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

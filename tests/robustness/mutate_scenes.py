@@ -22,7 +22,9 @@ import sys
 import tempfile
 import time
 
-SANITIZER_MARKERS = ("ERROR: AddressSanitizer", "ERROR: LeakSanitizer", "runtime error:", "UndefinedBehaviorSanitizer")
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import SANITIZER_MARKERS, Failures, fail  # noqa: E402  (tests/harness.py)
+
 NUMBER = re.compile(rb"(?<![\w.])-?\d+(\.\d+)?([eE][-+]?\d+)?(?![\w.])")
 KEY = re.compile(rb"^(\s*-?\s*)(\w+):", re.MULTILINE)
 NASTY_NUMBERS = [b"0", b"-1", b"-0", b"1e308", b"-1e308", b"1e-320", b"1e400", b".nan", b"nan", b".inf", b"-.inf",
@@ -89,7 +91,7 @@ def main():
 
     seeds = sorted(glob.glob(os.path.join(args.source_dir, "examples", "**", "*.yaml"), recursive=True))
     if not seeds:
-        sys.exit("mutate_scenes: no example scenes found")
+        fail("no example scenes found")
     rng = random.Random(args.seed)
     work = tempfile.mkdtemp(prefix="whitted-mutate-")
     # Mesh files the seeds name, beside the mutated scenes.
@@ -156,9 +158,10 @@ def main():
     print(f"mutate_scenes: {args.count} mutants of {len(texts)} scenes in {elapsed:.1f} s; exit codes {codes}")
     for n, name, size in slow:
         print(f"  slow but legal (stopped by SIGINT): mutant {n} of {name}, (width, height), samples, max_depth: {size}")
+    verdict = Failures()
     for n, name, problem, err in failures:
-        print(f"FAIL mutant {n} of {name}: {problem}\n{err}")
-    sys.exit(1 if failures else 0)
+        verdict.fail(f"mutant {n} of {name}: {problem}\n{err}")
+    verdict.finish()
 
 
 if __name__ == "__main__":

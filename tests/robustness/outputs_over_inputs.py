@@ -22,6 +22,9 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, run  # noqa: E402  (tests/harness.py)
+
 SCENE = """version: 1
 camera: { eye: [0, 0, 5], look_at: [0, 0, 0] }
 image: { width: 8, height: 8 }
@@ -56,26 +59,16 @@ def snapshot(d):
 
 def main():
     whitted = os.path.abspath(sys.argv[1])
-    failures = []
+    failures = Failures()
     env = dict(os.environ, WHITTED_POVRAY="/bin/false")  # POV-Ray must never be reached
 
     def refused(what, command, cwd, says, names, stdout=subprocess.PIPE, watch=None):
         before = snapshot(watch or cwd)
-        try:
-            result = subprocess.run(command, cwd=cwd, stdout=stdout, stderr=subprocess.PIPE, text=True,
-                                    timeout=TIMEOUT, env=env)
-        except subprocess.TimeoutExpired:
-            failures.append(f"{what}: hung")
-            return
-        if result.returncode != 2:
-            failures.append(f"{what}: exit {result.returncode}, expected 2\n{result.stderr}")
-        for fragment in [says] + names:
-            if fragment not in result.stderr:
-                failures.append(f"{what}: the message does not say '{fragment}': {result.stderr!r}")
+        failures.refused(what, command, [says] + names, timeout=TIMEOUT, cwd=cwd, stdout=stdout, env=env)
         after = snapshot(watch or cwd)
         if after != before:
             changed = sorted(k for k in set(before) | set(after) if before.get(k) != after.get(k))
-            failures.append(f"{what}: files changed: {changed}")
+            failures.fail(f"{what}: files changed: {changed}")
 
     with tempfile.TemporaryDirectory(prefix="whitted-own-outputs-") as d:
         # check: the scene is one of the report's files.
@@ -138,7 +131,7 @@ def main():
             with open(stdout_path, "a") as out:
                 refused(f"{what} a link to /proc/self/fd/1", command, links, "symbolic link", [name], stdout=out)
             if open(stdout_path).read() != "stdout stays\n":
-                failures.append(f"{what} a link to /proc/self/fd/1: the standard output file was written")
+                failures.fail(f"{what} a link to /proc/self/fd/1: the standard output file was written")
 
         # convert into an immutable directory: refused before the mesh is read.
         with open(os.path.join(work, "g.obj"), "w") as f:
@@ -147,7 +140,7 @@ def main():
             f.write(MESH_SCENE.replace("MESH", "g.obj"))
         locked = os.path.join(d, "locked")
         os.mkdir(locked)
-        lock = subprocess.run(["chattr", "+i", locked], capture_output=True, text=True)
+        lock = run(["chattr", "+i", locked], expect=None)
         if lock.returncode != 0:
             print(f"SKIP immutable directory: chattr +i failed ({lock.stderr.strip()})")
         else:
@@ -158,7 +151,7 @@ def main():
                         "cannot create a file in directory", ["x.pov"])
                 print(f"immutable directory: refused in {time.monotonic() - start:.3f} s")
             finally:
-                subprocess.run(["chattr", "-i", locked])
+                run(["chattr", "-i", locked])
 
         # A re-render over a set-user-ID file: the new image keeps the permissions, not the bit.
         scene = os.path.join(links, "s.yaml")
@@ -166,18 +159,14 @@ def main():
         with open(setuid, "w") as f:
             f.write("old")
         os.chmod(setuid, 0o4755)
-        result = subprocess.run([whitted, "render", scene, "-o", setuid, "-q"], capture_output=True, text=True,
-                                timeout=TIMEOUT)
+        result = run([whitted, "render", scene, "-o", setuid, "-q"], expect=None, timeout=TIMEOUT)
         mode = stat.S_IMODE(os.stat(setuid).st_mode)
         if result.returncode != 0 or mode != 0o755:
-            failures.append(f"re-render over a 4755 file: exit {result.returncode}, mode {oct(mode)}, expected "
+            failures.fail(f"re-render over a 4755 file: exit {result.returncode}, mode {oct(mode)}, expected "
                             f"0o755\n{result.stderr}")
 
-    for failure in failures:
-        print("FAIL", failure)
-    print("outputs over inputs: all refused" if not failures else f"{len(failures)} failure(s)")
-    return 1 if failures else 0
+    failures.finish("outputs over inputs: all refused")
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

@@ -20,6 +20,9 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, run  # noqa: E402  (tests/harness.py)
+
 # Many mirrors and lights at a high resolution: seconds of work on any machine, tiles short.
 SCENE = """version: 1
 camera: { eye: [0, 3, 9], look_at: [0, 0.5, 0], fov: 55 }
@@ -39,7 +42,7 @@ objects:
 OLD_BYTES = b"the previous render: must survive any signal\n" * 100
 
 
-def run(whitted, directory, threads, sig, after, scene_text):
+def interrupt_render(whitted, directory, threads, sig, after, scene_text):
     output = os.path.join(directory, "out.exr")
     with open(output, "wb") as f:
         f.write(OLD_BYTES)
@@ -104,7 +107,7 @@ def convert_cases(whitted, directory):
                 "materials:\n  m: { kd: 0.5 }\nobjects:\n  - { type: mesh, file: grid.obj, material: m }\n")
     pov, ini = os.path.join(directory, "out.pov"), os.path.join(directory, "out.ini")
     started = time.monotonic()
-    subprocess.run([whitted, "convert", scene, pov], check=True, stderr=subprocess.DEVNULL)
+    run([whitted, "convert", scene, pov])
     duration = time.monotonic() - started
     complete = {pov: open(pov, "rb").read(), ini: open(ini, "rb").read()}
     expected_files = {"grid.obj", "mesh.yaml", "out.pov", "out.ini"}
@@ -133,7 +136,7 @@ def convert_cases(whitted, directory):
             ours = {f".{os.path.basename(p)}.whitted-{process.pid}.tmp{os.path.splitext(p)[1]}" for p in (pov, ini)}
             if not set(leftovers) <= ours:
                 problems.append(f"convert, SIGKILL at {fraction:.0%}: files left behind: {leftovers}")
-            subprocess.run([whitted, "convert", scene, pov], check=True, stderr=subprocess.DEVNULL)
+            run([whitted, "convert", scene, pov])
             leftovers = sorted(set(os.listdir(directory)) - expected_files)
             if leftovers:
                 problems.append(f"convert after a SIGKILL: the killed run's temporaries were not removed: {leftovers}")
@@ -149,20 +152,20 @@ def main():
     parser.add_argument("whitted")
     parser.add_argument("--threads", type=int, default=2)
     args = parser.parse_args()
-    failures = []
+    failures = Failures()
     with tempfile.TemporaryDirectory(prefix="whitted-signal-") as directory:
         with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "heavy_tile.yaml")) as f:
             heavy = f.read()
         for sig, after, name, text in ((signal.SIGINT, 1.0, "large", SCENE), (signal.SIGTERM, 1.0, "large", SCENE),
                                        (signal.SIGKILL, 1.5, "large", SCENE), (signal.SIGINT, 1.0, "heavy tile", heavy)):
-            problems, took = run(args.whitted, directory, args.threads, sig, after, text)
+            problems, took = interrupt_render(args.whitted, directory, args.threads, sig, after, text)
             print(f"{name} render, {sig.name} after {after} s: stopped in {took:.3f} s" + ("" if problems else ", ok"))
-            failures += problems
+            for problem in problems:
+                failures.fail(problem)
     with tempfile.TemporaryDirectory(prefix="whitted-signal-convert-") as directory:
-        failures += convert_cases(args.whitted, directory)
-    for problem in failures:
-        print("FAIL " + problem)
-    sys.exit(1 if failures else 0)
+        for problem in convert_cases(args.whitted, directory):
+            failures.fail(problem)
+    failures.finish()
 
 
 if __name__ == "__main__":

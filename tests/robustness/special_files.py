@@ -14,6 +14,9 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, run  # noqa: E402  (tests/harness.py)
+
 SCENE_HEAD = """version: 1
 camera: { eye: [0, 0, 5], look_at: [0, 0, 0] }
 image: { width: 8, height: 8 }
@@ -33,7 +36,7 @@ TIMEOUT = 20
 
 def main():
     whitted = os.path.abspath(sys.argv[1])
-    failures = []
+    failures = Failures()
     with tempfile.TemporaryDirectory(prefix="whitted-special-") as d:
         fifo = os.path.join(d, "fifo")
         os.mkfifo(fifo)
@@ -73,16 +76,8 @@ def main():
 
         def expect_refused(command, what, named, env=None):
             """The command exits 2, in bounded time, saying `named` is not a regular file."""
-            try:
-                r = subprocess.run([whitted, *command], stdin=subprocess.DEVNULL, capture_output=True, text=True,
-                                   timeout=TIMEOUT, cwd=d, env={**os.environ, **(env or {})})
-            except subprocess.TimeoutExpired:
-                failures.append(f"{command[0]}, {what}: still running after {TIMEOUT} s")
-                return
-            ok = r.returncode == 2 and "not a regular file" in r.stderr and named in r.stderr
-            print(f"{'ok' if ok else 'FAIL'}: {command[0]}, {what}: exit {r.returncode}: {r.stderr.strip()}")
-            if not ok:
-                failures.append(f"{command[0]}, {what}: exit {r.returncode}, {r.stderr!r}")
+            failures.refused(f"{command[0]}, {what}", [whitted, *command], ["not a regular file", named],
+                             timeout=TIMEOUT, stdin=subprocess.DEVNULL, cwd=d, env={**os.environ, **(env or {})})
 
         # The OpenColorIO config: a FIFO given with --ocio-config or $OCIO is refused before OCIO
         # opens it (it would wait for a writer forever).
@@ -129,12 +124,7 @@ colorspaces:
                         "convert": ["convert", scene, output],
                         "explain": ["explain", scene, "--pixel", "4,4"]}[command]
                 start = time.monotonic()
-                try:
-                    r = subprocess.run([whitted, *args], stdin=subprocess.DEVNULL, capture_output=True, text=True,
-                                       timeout=TIMEOUT, cwd=d)
-                except subprocess.TimeoutExpired:
-                    failures.append(f"{command}, {what}: still running after {TIMEOUT} s (hung on the file)")
-                    continue
+                r = run([whitted, *args], expect=None, timeout=TIMEOUT, stdin=subprocess.DEVNULL, cwd=d)
                 seconds = time.monotonic() - start
                 problems = []
                 warned = what.startswith("MTL file")
@@ -153,14 +143,10 @@ colorspaces:
                 for extra in [output[:-4] + ".ini"] if command == "convert" else []:
                     if os.path.exists(extra):
                         os.unlink(extra)
-                status = "FAIL" if problems else "ok"
-                print(f"{status}: {command}, {what}: exit {r.returncode} in {seconds:.2f} s: {r.stderr.strip()}")
-                if problems:
-                    failures.append(f"{command}, {what}: " + "; ".join(problems))
-    for f in failures:
-        print("FAIL:", f, file=sys.stderr)
-    return 1 if failures else 0
+                failures.check(not problems, f"{command}, {what}: exit {r.returncode} in {seconds:.2f} s: "
+                                             + ("; ".join(problems) + ": " if problems else "") + r.stderr.strip())
+    failures.finish()
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

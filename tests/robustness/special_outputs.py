@@ -11,9 +11,11 @@ Usage: special_outputs.py WHITTED"""
 
 import os
 import stat
-import subprocess
 import sys
 import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, run  # noqa: E402  (tests/harness.py)
 
 SCENE = """version: 1
 camera: { eye: [0, 0, 5], look_at: [0, 0, 0] }
@@ -27,7 +29,7 @@ TIMEOUT = 60
 
 def main():
     whitted = os.path.abspath(sys.argv[1])
-    failures = []
+    failures = Failures()
     with tempfile.TemporaryDirectory(prefix="whitted-outputs-") as d:
         scene = os.path.join(d, "scene.yaml")
         with open(scene, "w") as f:
@@ -56,19 +58,11 @@ def main():
         def refused(what, command, path, says):
             before = kind(path)
             listing = sorted(os.listdir(d))
-            try:
-                result = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT)
-            except subprocess.TimeoutExpired:
-                failures.append(f"{what}: hung")
-                return
-            if result.returncode != 2:
-                failures.append(f"{what}: exit {result.returncode}, expected 2\n{result.stderr}")
-            if says not in result.stderr or os.path.basename(path) not in result.stderr:
-                failures.append(f"{what}: message does not say '{says}' and name the path: {result.stderr!r}")
+            failures.refused(what, command, [says, os.path.basename(path)], timeout=TIMEOUT)
             if kind(path) != before:
-                failures.append(f"{what}: {path} was replaced")
+                failures.fail(f"{what}: {path} was replaced")
             if sorted(os.listdir(d)) != listing:
-                failures.append(f"{what}: files changed: {sorted(set(os.listdir(d)) ^ set(listing))}")
+                failures.fail(f"{what}: files changed: {sorted(set(os.listdir(d)) ^ set(listing))}")
 
         for what, path in nodes.items():
             if path.endswith((".png", ".exr")):
@@ -92,25 +86,20 @@ def main():
                 [whitted, "convert", ini_scene, os.path.join(d, "scene.pov")], ini_scene, "input")
         with open(scene) as f:
             if f.read() != original:
-                failures.append("convert a.yaml a.yaml changed its input")
+                failures.fail("convert a.yaml a.yaml changed its input")
 
         # A replaced regular file keeps its mode.
         private = os.path.join(d, "private.png")
         with open(private, "w") as f:
             f.write("old")
         os.chmod(private, 0o600)
-        result = subprocess.run([whitted, "render", scene, "-o", private, "-q"], capture_output=True, text=True,
-                                timeout=TIMEOUT)
+        result = run([whitted, "render", scene, "-o", private, "-q"], expect=None, timeout=TIMEOUT)
         mode = stat.S_IMODE(os.stat(private).st_mode)
         if result.returncode != 0 or mode != 0o600:
-            failures.append(f"re-render over a 0600 file: exit {result.returncode}, mode {oct(mode)}\n{result.stderr}")
+            failures.fail(f"re-render over a 0600 file: exit {result.returncode}, mode {oct(mode)}\n{result.stderr}")
 
-    for failure in failures:
-        print("FAIL", failure)
-    print(f"special outputs: {len(nodes)} nodes and 3 own inputs refused, modes kept" if not failures
-          else f"special outputs: {len(failures)} failure(s)")
-    return 1 if failures else 0
+    failures.finish(f"special outputs: {len(nodes)} nodes and 3 own inputs refused, modes kept")
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

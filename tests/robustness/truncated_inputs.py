@@ -18,6 +18,9 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures  # noqa: E402  (tests/harness.py)
+
 ATTEMPTS = 24  # per file, at most; stops after HITS_WANTED cuts inside the read
 HITS_WANTED = 3
 
@@ -43,7 +46,7 @@ def write_yaml(path, spheres=300000):
 
 def main():
     whitted = os.path.abspath(sys.argv[1])
-    failures = []
+    failures = Failures()
     with tempfile.TemporaryDirectory(prefix="whitted-truncated-") as d:
         obj_master, yaml_master = os.path.join(d, "master.obj"), os.path.join(d, "master.yaml")
         write_obj(obj_master)
@@ -66,12 +69,10 @@ def main():
         for what, master, victim, scene, command, hits_wanted in cases:
             shutil.copyfile(master, victim)
             start = time.monotonic()
-            whole = subprocess.run(command(scene), capture_output=True, text=True, timeout=300, env=env)
+            # Under check POV-Ray cannot run: the exit status of the whole check is not the point.
+            whole = failures.run(command(scene), expect=None if command is check else 0, timeout=300, env=env)
             seconds = time.monotonic() - start
-            if command is check:
-                pass  # POV-Ray cannot run: the exit status of the whole check is not the point
-            elif whole.returncode != 0:
-                failures.append(f"{what}: the untouched file does not render: exit {whole.returncode}\n{whole.stderr}")
+            if command is not check and whole.returncode != 0:
                 continue
             hits, outcomes = 0, []
             for attempt in range(ATTEMPTS):
@@ -92,35 +93,33 @@ def main():
                     _, stderr = process.communicate(timeout=300)
                 except subprocess.TimeoutExpired:
                     process.kill()
-                    failures.append(f"{what}: cut after {delay:.3f} s: hung")
+                    failures.fail(f"{what}: cut after {delay:.3f} s: hung")
                     continue
                 rc = process.returncode
                 outcomes.append(f"{delay:.3f}s->{rc}")
                 name = os.path.basename(victim)
                 if rc < 0 or rc > 128:
-                    failures.append(f"{what}: cut after {delay:.3f} s: killed by a signal (exit {rc})\n{stderr}")
+                    failures.fail(f"{what}: cut after {delay:.3f} s: killed by a signal (exit {rc})\n{stderr}")
                 elif rc == 1:
                     if "changed while it was read" not in stderr or name not in stderr:
-                        failures.append(f"{what}: cut after {delay:.3f} s: exit 1 without naming the change and "
+                        failures.fail(f"{what}: cut after {delay:.3f} s: exit 1 without naming the change and "
                                         f"'{name}': {stderr!r}")
                     hits += 1
                 elif "changed while it was read" in stderr:
-                    failures.append(f"{what}: cut after {delay:.3f} s: exit {rc} for a file that changed while it "
+                    failures.fail(f"{what}: cut after {delay:.3f} s: exit {rc} for a file that changed while it "
                                     f"was read; expected 1 (a failure, not bad input): {stderr!r}")
                 elif rc == 2 and command is check and "POV-Ray" in stderr:
                     pass  # the cut came after the read: the stand-in POV-Ray failed
                 elif rc == 2:
                     if name not in stderr:
-                        failures.append(f"{what}: cut after {delay:.3f} s: exit 2 without naming '{name}': {stderr!r}")
+                        failures.fail(f"{what}: cut after {delay:.3f} s: exit 2 without naming '{name}': {stderr!r}")
                 elif rc != 0:
-                    failures.append(f"{what}: cut after {delay:.3f} s: exit {rc}\n{stderr}")
+                    failures.fail(f"{what}: cut after {delay:.3f} s: exit {rc}\n{stderr}")
             print(f"{what}: whole run {seconds:.3f} s; cuts: {' '.join(outcomes)}; {hits} inside the read")
             if hits == 0:
-                failures.append(f"{what}: no cut landed inside the read in {len(outcomes)} attempts")
-    for failure in failures:
-        print("FAIL", failure)
-    return 1 if failures else 0
+                failures.fail(f"{what}: no cut landed inside the read in {len(outcomes)} attempts")
+    failures.finish()
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

@@ -20,13 +20,15 @@ Usage: check_examples.py [--root DIR] [--whitted PATH] [-v]
 import argparse
 import json
 import re
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
 import jsonschema
 import yaml
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from harness import Failures, fail, run  # noqa: E402  (tests/harness.py)
 
 
 class Yaml12Loader(yaml.SafeLoader):
@@ -121,9 +123,8 @@ def whitted_status(whitted, path, scratch):
     Whitted's own YAML, so that what only the POV-Ray converter refuses (the course's conventions)
     does not count against the scene."""
     try:
-        result = subprocess.run([whitted, "convert", str(path), str(Path(scratch) / "scene.yaml")],
-                                capture_output=True, text=True, timeout=120)
-    except (OSError, subprocess.SubprocessError) as e:
+        result = run([whitted, "convert", str(path), str(Path(scratch) / "scene.yaml")], expect=None, timeout=120)
+    except OSError as e:
         return None, f"cannot run {whitted}: {e}"
     return result.returncode, result.stderr.strip()
 
@@ -138,14 +139,13 @@ def main():
 
     root = args.root.resolve()
     schema_path = root / "docs" / "scene.schema.json"
-    failures = []
+    failures = Failures()
     try:
         schema = json.loads(schema_path.read_text(encoding="utf-8"))
         validator_class = jsonschema.validators.validator_for(schema)
         validator_class.check_schema(schema)
     except (OSError, ValueError, jsonschema.exceptions.SchemaError) as e:
-        print(f"FAIL {schema_path}: not a usable JSON Schema: {e}")
-        return 1
+        fail(f"{schema_path}: not a usable JSON Schema: {e}")
     validator = validator_class(schema)
 
     def scenes(folder):
@@ -154,8 +154,7 @@ def main():
     good = scenes(root / "examples") + scenes(here / "good")
     bad = scenes(here / "bad")
     if not good or not bad:
-        print(f"FAIL: found {len(good)} good and {len(bad)} bad scenes; expected some of each")
-        return 1
+        fail(f"found {len(good)} good and {len(bad)} bad scenes; expected some of each")
 
     def shown(path):
         return path.relative_to(root) if path.is_relative_to(root) else path
@@ -164,32 +163,29 @@ def main():
         for path in good:
             name = shown(path)
             for error in schema_errors(validator, path):
-                failures.append(f"FAIL {name}: the schema refuses a valid scene: {error}")
+                failures.fail(f"{name}: the schema refuses a valid scene: {error}")
             if args.whitted:
                 status, message = whitted_status(args.whitted, path, scratch)
                 if status != 0:
-                    failures.append(f"FAIL {name}: whitted refuses it (exit {status}): {message}")
+                    failures.fail(f"{name}: whitted refuses it (exit {status}): {message}")
             if args.verbose:
                 print(f"checked {name}")
         for path in bad:
             name = shown(path)
             reason = path.read_text(encoding="utf-8").splitlines()[0].lstrip("# ").strip()
             if not schema_errors(validator, path):
-                failures.append(f"FAIL {name}: the schema accepts a bad scene ({reason})")
+                failures.fail(f"{name}: the schema accepts a bad scene ({reason})")
             if args.whitted:
                 status, message = whitted_status(args.whitted, path, scratch)
                 if status != 2:
-                    failures.append(f"FAIL {name}: whitted exits {status}, expected 2 ({reason}): {message}")
+                    failures.fail(f"{name}: whitted exits {status}, expected 2 ({reason}): {message}")
             if args.verbose:
                 print(f"checked {name}: {reason}")
 
-    for failure in failures:
-        print(failure)
     checked = "schema and whitted" if args.whitted else "schema"
-    print(f"{len(good)} valid and {len(bad)} invalid scenes checked ({checked}): "
-          f"{'FAILED, ' + str(len(failures)) + ' problem(s)' if failures else 'all as expected'}")
-    return 1 if failures else 0
+    print(f"{len(good)} valid and {len(bad)} invalid scenes checked ({checked})")
+    failures.finish("all as expected")
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

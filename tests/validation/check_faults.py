@@ -25,6 +25,8 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import fake_povray  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, run  # noqa: E402  (tests/harness.py)
 REPORT_FILES = ["povray.log", "povray-16bit.png", "scene.pov", "scene.ini", "ours.exr", "povray.exr", "ours.png",
                 "povray.png", "diff.png", "metrics.json", "report-data.js", "report.html"]
 SCENE = ("version: 1\ncamera: { eye: [0, 0, 5], look_at: [0, 0, 0] }\n"
@@ -45,11 +47,10 @@ def symlinks(whitted, scene, povray):
         environment = dict(os.environ)
         if povray:
             environment["WHITTED_POVRAY"] = povray
-        run = subprocess.run([whitted, "check", scene, "-q", "--report", report], capture_output=True, text=True,
-                             env=environment, timeout=120)
-        print("check --report r (r full of symlinks): exit", run.returncode, run.stdout.strip())
-        if run.returncode != 0:
-            problems.append(f"symlinks: exit {run.returncode}: {run.stdout!r} {run.stderr!r}")
+        result = run([whitted, "check", scene, "-q", "--report", report], expect=None, timeout=120, env=environment)
+        print("check --report r (r full of symlinks): exit", result.returncode, result.stdout.strip())
+        if result.returncode != 0:
+            problems.append(f"symlinks: exit {result.returncode}: {result.stdout!r} {result.stderr!r}")
         for name in REPORT_FILES:
             with open(os.path.join(victim, name)) as f:
                 if f.read() != f"precious {name}: must not be overwritten through a symlink\n":
@@ -225,9 +226,10 @@ def main():
         problems = signals(args.whitted)
     else:
         problems = povray_signals(args.whitted)
+    failures = Failures()
     for problem in problems:
-        print("FAIL " + problem)
-    sys.exit(1 if problems else 0)
+        failures.fail(problem)
+    failures.finish()
 
 
 if __name__ == "__main__":

@@ -9,13 +9,14 @@ Usage: check_rules.py WHITTED VALIDATE_SCRIPT"""
 
 import json
 import os
-import subprocess
 import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import fake_povray  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, run  # noqa: E402  (tests/harness.py)
 SCENE = ("version: 1\ncamera: { eye: [0, 0, 5], look_at: [0, 0, 0] }\n"
          "image: { width: 96, height: 72, background: [0.5, 0.25, 0.125] }\n"
          "lights: []\nmaterials: {}\nobjects: []\n")
@@ -24,15 +25,14 @@ SIX_FAR = ";".join(f"{10 + 7 * i},{20 + i},1,{16384 + 1000}" for i in range(6)) 
 
 
 def check(whitted, scene, environment, *options):
-    run = subprocess.run([whitted, "check", scene, "-q", *options], capture_output=True, text=True,
-                         env=environment, timeout=120)
-    lines = run.stdout.strip().splitlines()
-    return run.returncode, lines[-1] if lines else "", run.stderr
+    result = run([whitted, "check", scene, "-q", *options], expect=None, timeout=120, env=environment)
+    lines = result.stdout.strip().splitlines()
+    return result.returncode, lines[-1] if lines else "", result.stderr
 
 
 def main():
     whitted, validate = sys.argv[1], sys.argv[2]
-    problems = []
+    problems = Failures()
     with tempfile.TemporaryDirectory(prefix="whitted-check-rules-") as directory:
         scene = os.path.join(directory, "background.yaml")
         with open(scene, "w") as f:
@@ -46,7 +46,7 @@ def main():
             print(f"{name}: exit {code}: {verdict}" + ("" if ok else f"  <- expected exit {expect_code}, "
                                                             f"{expect_in} and none of {list(expect_not_in)}"))
             if not ok:
-                problems.append(f"{name}: exit {code}, verdict {verdict!r}, stderr {stderr!r}")
+                problems.fail(f"{name}: exit {code}, verdict {verdict!r}, stderr {stderr!r}")
 
         case("agreeing images", 0, ["PASS ", "100.000% of pixels within 2/65535", "max 0.5 codes (cap 64)"],
              ["failed"])
@@ -71,44 +71,43 @@ def main():
         worst = metrics["worst_pixels"]
         injected = [[10 + 7 * i, 20 + i] for i in range(6)]
         if metrics["passed"] or metrics["failed_rules"] != ["cap"]:
-            problems.append(f"metrics.json: passed {metrics['passed']}, failed_rules {metrics['failed_rules']}")
+            problems.fail(f"metrics.json: passed {metrics['passed']}, failed_rules {metrics['failed_rules']}")
         if len(worst) != 10 or [[w["x"], w["y"]] for w in worst[:6]] != injected:
-            problems.append(f"metrics.json worst_pixels: {[[w['x'], w['y']] for w in worst]}, expected 10 "
+            problems.fail(f"metrics.json worst_pixels: {[[w['x'], w['y']] for w in worst]}, expected 10 "
                             f"starting with {injected}")
         elif abs(worst[0]["error_codes"] - 1000.25) > 0.01 or worst[6]["error_codes"] > 1:
-            problems.append(f"metrics.json worst errors: {[w['error_codes'] for w in worst]}")
+            problems.fail(f"metrics.json worst errors: {[w['error_codes'] for w in worst]}")
         with open(os.path.join(report, "report.html")) as f:
             html = f.read()
         if "The 10 worst pixels" not in html or "<li><code>cap (max 1000." not in html:
-            problems.append("report.html does not list the 10 worst pixels and the broken rule")
-        print("report: worst", [[w["x"], w["y"]] for w in worst], "ok" if not problems else "")
+            problems.fail("report.html does not list the 10 worst pixels and the broken rule")
+        print("report: worst", [[w["x"], w["y"]] for w in worst], "ok" if not problems.messages else "")
 
         # scripts/validate reads the verdict line: its summary shows the figures and the rule.
-        run = subprocess.run(["bash", validate, "--out", os.path.join(directory, "validation"), scene],
-                             capture_output=True, text=True, timeout=120,
-                             env=dict(base, FAKE_POVRAY_PIXELS=SIX_FAR,
+        result = run(["bash", validate, "--out", os.path.join(directory, "validation"), scene], expect=None,
+                     timeout=120, env=dict(base, FAKE_POVRAY_PIXELS=SIX_FAR,
                                       WHITTED_BUILD_DIR=os.path.dirname(os.path.dirname(whitted))))
-        print("scripts/validate:", run.stdout.strip().replace("\n", " | "))
-        if run.returncode != 1 or "FAIL background: max 1000." not in run.stdout or \
-                "codes, 99.913% within; failed: cap (max 1000." not in run.stdout:
-            problems.append(f"scripts/validate: exit {run.returncode}, output {run.stdout!r} {run.stderr!r}")
+        print("scripts/validate:", result.stdout.strip().replace("\n", " | "))
+        if result.returncode != 1 or "FAIL background: max 1000." not in result.stdout or \
+                "codes, 99.913% within; failed: cap (max 1000." not in result.stdout:
+            problems.fail(f"scripts/validate: exit {result.returncode}, output {result.stdout!r} {result.stderr!r}")
         # A scene file name that is not UTF-8 (byte 0xE9): the report is still JSON, written whole
         # (it printed PASS, then failed writing metrics.json with exit 2).
         latin1 = os.path.join(os.fsencode(directory), b"caf\xe9.yaml")
         with open(latin1, "w") as f:
             f.write(SCENE)
         latin1_report = os.path.join(directory, "latin1-report")
-        run = subprocess.run([os.fsencode(whitted), b"check", latin1, b"-q", b"--report", os.fsencode(latin1_report)],
-                             capture_output=True, env=base, timeout=120)
+        result = run([os.fsencode(whitted), b"check", latin1, b"-q", b"--report", os.fsencode(latin1_report)],
+                     expect=None, timeout=120, text=False, env=base)
         try:
             with open(os.path.join(latin1_report, "metrics.json"), encoding="utf-8") as f:
                 named = json.load(f)["scene"]
-            ok = run.returncode == 0 and named.endswith("caf\ufffd.yaml")
+            ok = result.returncode == 0 and named.endswith("caf\ufffd.yaml")
         except (OSError, ValueError, KeyError) as e:
             ok, named = False, repr(e)
-        print(f"scene name not UTF-8: exit {run.returncode}, metrics.json names {named!r}", "ok" if ok else "")
+        print(f"scene name not UTF-8: exit {result.returncode}, metrics.json names {named!r}", "ok" if ok else "")
         if not ok:
-            problems.append(f"scene name not UTF-8: exit {run.returncode}, {run.stderr!r}, {named!r}")
+            problems.fail(f"scene name not UTF-8: exit {result.returncode}, {result.stderr!r}, {named!r}")
         # A report directory under a file is a usage error found before the scene is even read: with
         # a scene that is itself wrong, the report directory is what the message names (it was
         # found only after the render, 28-38 s into a large scene). The fake POV-Ray never runs.
@@ -119,16 +118,14 @@ def main():
         with open(broken, "w") as f:
             f.write("version: 1\nimage: {width: x}\n")
         marker = os.path.join(directory, "povray-ran")
-        run = subprocess.run([whitted, "check", broken, "-q", "--report", os.path.join(blocker, "report")],
-                             capture_output=True, text=True, env=dict(base, FAKE_POVRAY_MARKER=marker), timeout=120)
-        ok = run.returncode == 2 and f"'{blocker}' is not a directory" in run.stderr and \
-            "broken.yaml" not in run.stderr and not os.path.exists(marker)
-        print(f"report under a file: exit {run.returncode}: {run.stderr.strip()}", "ok" if ok else "")
+        result = run([whitted, "check", broken, "-q", "--report", os.path.join(blocker, "report")], expect=None,
+                     timeout=120, env=dict(base, FAKE_POVRAY_MARKER=marker))
+        ok = result.returncode == 2 and f"'{blocker}' is not a directory" in result.stderr and \
+            "broken.yaml" not in result.stderr and not os.path.exists(marker)
+        print(f"report under a file: exit {result.returncode}: {result.stderr.strip()}", "ok" if ok else "")
         if not ok:
-            problems.append(f"report under a file: exit {run.returncode}, {run.stderr!r}")
-    for problem in problems:
-        print("FAIL " + problem)
-    sys.exit(1 if problems else 0)
+            problems.fail(f"report under a file: exit {result.returncode}, {result.stderr!r}")
+    problems.finish()
 
 
 if __name__ == "__main__":

@@ -10,9 +10,11 @@ and their exposures tests/image/ref/references.txt.
 """
 
 import os
-import subprocess
 import sys
 import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, run  # noqa: E402  (tests/harness.py)
 
 
 def main():
@@ -25,20 +27,18 @@ def main():
             fields = line.split()
             exposures[fields[0]] = fields[1]
     env = dict(os.environ, WHITTED_POVRAY="/nonexistent/povray")  # POV-Ray must not be needed
-    problems = []
+    problems = Failures()
 
     def check(name, args, status, text):
-        r = subprocess.run([whitted, "check", "-q", *args], env=env, capture_output=True, text=True, timeout=60)
+        r = run([whitted, "check", "-q", *args], expect=None, timeout=60, env=env)
         out = r.stdout + r.stderr
-        ok = r.returncode == status and text in out
-        print(f"{'ok  ' if ok else 'FAIL'} {name}: exit {r.returncode} (want {status}), {out.strip()[-160:]!r}")
-        if not ok:
-            problems.append(f"{name}: exit {r.returncode}, wanted {status} and {text!r} in: {out}")
+        problems.check(r.returncode == status and text in out,
+                       f"{name}: exit {r.returncode} (want {status} and {text!r} in the output), {out.strip()[-160:]!r}")
 
     scene = lambda n: os.path.join(pov, n + ".yaml")
     png = lambda n: os.path.join(ref, n + ".png")
     e = exposures["values_above_1"]
-    assert float(e) < 1, "values_above_1 should need an exposure below 1"
+    problems.require(float(e) < 1, "values_above_1 should need an exposure below 1")
     check("right image, right exposure", [scene("values_above_1"), "--povray-image", png("values_above_1"),
                                           "--exposure", e], 0, "PASS")
     check("right image, twice the exposure", [scene("values_above_1"), "--povray-image", png("values_above_1"),
@@ -59,13 +59,11 @@ def main():
                 f.write(f"version: 1\ncamera: {{eye: [0, 0, 5], look_at: [0, 0, 0]}}\n"
                         f"image: {{width: 5, height: 3, background: [{value}, {value}, {value}]}}\n")
         white = os.path.join(tmp, "white.png")
-        subprocess.run([whitted, "render", "-q", bright, "-o", white, "--bit-depth", "16"], check=True, timeout=60)
+        run([whitted, "render", "-q", bright, "-o", white, "--bit-depth", "16"], timeout=60)
         check("a stored image that clipped", [dark, "--povray-image", white], 1, "clipped")
 
-    for p in problems:
-        print("FAIL " + p, file=sys.stderr)
-    return 1 if problems else 0
+    problems.finish()
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

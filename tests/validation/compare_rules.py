@@ -9,27 +9,25 @@
 Usage: compare_rules.py WHITTED OIIOTOOL"""
 
 import os
-import subprocess
 import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import images  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, run  # noqa: E402  (tests/harness.py)
 
 CODE = 1 / 65535
 
 
 def compare(whitted, *arguments, timeout=30):
-    try:
-        run = subprocess.run([whitted, "compare", *arguments], capture_output=True, text=True, timeout=timeout)
-    except subprocess.TimeoutExpired:
-        return None, "", f"still running after {timeout} s"
-    return run.returncode, run.stdout.strip(), run.stderr.strip()
+    result = run([whitted, "compare", *arguments], expect=None, timeout=timeout)
+    return result.returncode, result.stdout.strip(), result.stderr.strip()
 
 
 def main():
     whitted, oiiotool = sys.argv[1], sys.argv[2]
-    problems = []
+    problems = Failures()
     with tempfile.TemporaryDirectory(prefix="whitted-compare-rules-") as d:
         def exr(name, value=0.5, overrides=None, width=96, height=72, channels=3):
             path = os.path.join(d, name + ".exr")
@@ -43,7 +41,7 @@ def main():
             ok = code == expect_code and all(t in out for t in expect_in) and not any(t in out for t in expect_not_in)
             print(f"{name}: exit {code}: {out or err}" + ("" if ok else "  <- unexpected"))
             if not ok:
-                problems.append(f"{name}: exit {code}, stdout {out!r}, stderr {err!r}")
+                problems.fail(f"{name}: exit {code}, stdout {out!r}, stderr {err!r}")
 
         case("identical", reference, 0, ["PASS ", "max 0.0 codes (cap 64)"], ["failed"])
         six = {(10 + i, 30, 0): 0.5 + 1000 * CODE for i in range(6)}
@@ -63,7 +61,7 @@ def main():
         case("grey against RGB", exr("grey", channels=1), 1, ["FAIL ", "failed: channels (3 vs 1: colour against grey)"])
         # The colour is what is compared: RGBA (or an EXR with render layers) against RGB passes.
         rgba = os.path.join(d, "rgba.exr")
-        subprocess.run([oiiotool, exr("rgb"), "--ch", "R,G,B,A=1.0", "-o", rgba], check=True)
+        run([oiiotool, exr("rgb"), "--ch", "R,G,B,A=1.0", "-o", rgba])
         case("RGBA against RGB", rgba, 0, ["PASS "])
 
         def refused(name, path, fragment):
@@ -71,7 +69,7 @@ def main():
             ok = code == 2 and err.startswith("whitted: error: ") and fragment in err and not out
             print(f"{name}: exit {code}: {err}" + ("" if ok else "  <- unexpected"))
             if not ok:
-                problems.append(f"{name}: exit {code}, stdout {out!r}, stderr {err!r} (expected exit 2, {fragment!r})")
+                problems.fail(f"{name}: exit {code}, stdout {out!r}, stderr {err!r} (expected exit 2, {fragment!r})")
 
         huge = os.path.join(d, "huge.png")
         images.png_claiming(huge, 65535, 65535)
@@ -87,14 +85,12 @@ def main():
         code, out, err = compare(whitted, reference, whole)  # the uncut file reads: the cut was the fault
         # Its verdict is the last line (compare first says how it decoded each file).
         if code not in (0, 1) or not out.strip().splitlines()[-1:][0].startswith(("PASS", "FAIL")):
-            problems.append(f"the complete PNG did not compare: exit {code}, {out!r} {err!r}")
+            problems.fail(f"the complete PNG did not compare: exit {code}, {out!r} {err!r}")
         refused("/dev/zero", "/dev/zero", "'/dev/zero': it is a character device")
         fifo = os.path.join(d, "fifo.png")
         os.mkfifo(fifo)
         refused("a fifo", fifo, "it is a fifo")
-    for problem in problems:
-        print("FAIL " + problem)
-    sys.exit(1 if problems else 0)
+    problems.finish()
 
 
 if __name__ == "__main__":

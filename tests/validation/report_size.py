@@ -6,9 +6,11 @@ every file's size is printed and the total must stay under BOUND bytes.
 
 usage: report_size.py WHITTED SOURCE_DIR"""
 import os
-import subprocess
 import sys
 import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import fail, run  # noqa: E402  (tests/harness.py)
 
 BOUND = 6_500_000  # measured 5.9 MB; the uncompressed EXRs or the raw floats in report-data.js break it
 
@@ -21,19 +23,14 @@ def main():
     with open(os.path.join(source, "tests", "pov", "three_coloured_lights.yaml")) as f:
         scene = f.read()
     if "image: { width: 96, height: 72 }" not in scene:
-        print("FAIL: three_coloured_lights.yaml no longer has the image line this test resizes")
-        sys.exit(1)
+        fail("three_coloured_lights.yaml no longer has the image line this test resizes")
     with tempfile.TemporaryDirectory(prefix="whitted-report-size-") as d:
         path = os.path.join(d, "scene.yaml")
         with open(path, "w") as f:
             f.write(scene.replace("image: { width: 96, height: 72 }", "image: { width: 640, height: 480 }"))
         report = os.path.join(d, "report")
-        run = subprocess.run([whitted, "check", path, "-q", "--report", report], capture_output=True, text=True,
-                             timeout=300, env=dict(os.environ, HOME=d))
-        print(run.stdout, end="")
-        if run.returncode != 0:
-            print(f"FAIL: whitted check exited {run.returncode}: {run.stderr}")
-            sys.exit(1)
+        print(run([whitted, "check", path, "-q", "--report", report], timeout=300,
+                  env=dict(os.environ, HOME=d)).stdout, end="")
         total = 0
         for name in sorted(os.listdir(report)):
             size = os.path.getsize(os.path.join(report, name))
@@ -41,8 +38,7 @@ def main():
             print(f"{size:>10}  {name}")
         print(f"{total:>10}  total (bound {BOUND})")
         if total > BOUND:
-            print(f"FAIL: the 640x480 report is {total} bytes, more than {BOUND}")
-            sys.exit(1)
+            fail(f"the 640x480 report is {total} bytes, more than {BOUND}")
 
 
 if __name__ == "__main__":
