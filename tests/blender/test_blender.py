@@ -1,24 +1,16 @@
 #!/usr/bin/python3
 """ctest blender.render: the add-on's render equals `whitted render` of the EXPORTED file bit for bit;
 instances and prototypes are keyed by evaluated mesh."""
-import json, os, shutil, subprocess, sys, tempfile
+import json, os, sys, tempfile
 import numpy as np
-if shutil.which("blender") is None:
-    print("SKIPPED: blender is not installed (apt-get install blender)"); sys.exit(77)
-if os.environ.get("WHITTED_TEST_SANITIZED"):
-    # Blender is not built with AddressSanitizer, so it cannot load the ASan-built module (the
-    # runtime must come first); the plain build's run of this test is the one that counts.
-    print("SKIPPED: sanitizer build: Blender cannot load the ASan-built whitted module; "
-          "run in the plain build (scripts/test)"); sys.exit(77)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from headless import blender, require_blender, run  # noqa: E402  (tests/blender/headless.py)
+require_blender()
 import OpenImageIO as oiio
-here = os.path.dirname(os.path.abspath(__file__))
 out = tempfile.mkdtemp(prefix="whitted-blender-")
-r = subprocess.run(["blender", "-b", "--factory-startup", "--python-exit-code", "1",
-                    "--python", os.path.join(here, "scene.py"), "--", out], capture_output=True, text=True)
-if r.returncode != 0:
-    print(r.stdout[-3000:], r.stderr[-3000:]); sys.exit(1)
+blender("scene.py", out)
 exported = os.path.join(out, "export.json")
-subprocess.run([os.environ["WHITTED"], "render", exported, "-o", os.path.join(out, "cli.exr")], check=True)
+run([os.environ["WHITTED"], "render", exported, "-o", os.path.join(out, "cli.exr")])
 a = oiio.ImageBuf(os.path.join(out, "blender.exr")).get_pixels(oiio.FLOAT)[:, :, :3]
 b = oiio.ImageBuf(os.path.join(out, "cli.exr")).get_pixels(oiio.FLOAT)[:, :, :3]
 assert a.shape == (48, 64, 3) and b.shape == a.shape, (a.shape, b.shape)

@@ -1,23 +1,15 @@
 #!/usr/bin/python3
 """ctest blender.errors / blender.cancel / blender.check_pov / blender.exposure: run tests/blender/checks.py MODE in
 headless Blender and assert on what it recorded. Usage: test_checks.py MODE"""
-import json, math, os, shutil, subprocess, sys, tempfile
+import json, math, os, shutil, sys, tempfile
 mode = sys.argv[1]
-if shutil.which("blender") is None:
-    print("SKIPPED: blender is not installed (apt-get install blender)"); sys.exit(77)
-if os.environ.get("WHITTED_TEST_SANITIZED"):
-    # Blender is not built with AddressSanitizer, so it cannot load the ASan-built module (the
-    # runtime must come first); the plain build's run of this test is the one that counts.
-    print("SKIPPED: sanitizer build: Blender cannot load the ASan-built whitted module; "
-          "run in the plain build (scripts/test)"); sys.exit(77)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from headless import blender, require_blender, skip  # noqa: E402  (tests/blender/headless.py)
+require_blender()
 if mode == "check_pov" and shutil.which("povray") is None:
-    print("SKIPPED: povray is not installed (apt-get install povray)"); sys.exit(77)
-here = os.path.dirname(os.path.abspath(__file__))
+    skip("povray is not installed (apt-get install povray)")
 out = tempfile.mkdtemp(prefix=f"whitted-blender-{mode}-")
-r = subprocess.run(["blender", "-b", "--factory-startup", "--python-exit-code", "1",
-                    "--python", os.path.join(here, "checks.py"), "--", mode, out], capture_output=True, text=True)
-if r.returncode != 0:
-    print(r.stdout[-3000:], r.stderr[-3000:]); sys.exit(1)
+blender("checks.py", mode, out)
 res = json.load(open(os.path.join(out, "result.json")))
 if mode == "errors":
     assert "camera lens shift is not supported" in res["shift"], res["shift"]

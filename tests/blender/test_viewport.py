@@ -2,20 +2,14 @@
 """ctest blender.viewport: the viewport's camera from a view's matrices, what a change re-does (a view
 move re-renders without re-exporting), cancellation, and the pixels it draws equal `whitted render` of
 the scene text it rendered (which is F12's export with the view's camera), bit for bit."""
-import json, math, os, shutil, subprocess, sys, tempfile
+import json, math, os, sys, tempfile
 import numpy as np
-if shutil.which("blender") is None:
-    print("SKIPPED: blender is not installed (apt-get install blender)"); sys.exit(77)
-if os.environ.get("WHITTED_TEST_SANITIZED"):
-    print("SKIPPED: sanitizer build: Blender cannot load the ASan-built whitted module; "
-          "run in the plain build (scripts/test)"); sys.exit(77)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from headless import blender, require_blender, run  # noqa: E402  (tests/blender/headless.py)
+require_blender()
 import OpenImageIO as oiio
-here = os.path.dirname(os.path.abspath(__file__))
 out = tempfile.mkdtemp(prefix="whitted-blender-viewport-")
-r = subprocess.run(["blender", "-b", "--factory-startup", "--python-exit-code", "1",
-                    "--python", os.path.join(here, "viewport_checks.py"), "--", out], capture_output=True, text=True)
-if r.returncode != 0:
-    print(r.stdout[-3000:], r.stderr[-3000:]); sys.exit(1)
+blender("viewport_checks.py", out)
 res = json.load(open(os.path.join(out, "result.json")))
 
 
@@ -58,8 +52,7 @@ assert res["superseded_ready"], res
 assert [1200, 1600, 3] not in res["superseded_images"], res["superseded_images"]
 assert not res["stopped_alive"], res
 # 3. pixels: the uploaded buffer equals `whitted render` of the text the viewport rendered
-subprocess.run([os.environ["WHITTED"], "render", os.path.join(out, "view.json"), "-o", os.path.join(out, "cli.exr")],
-               check=True)
+run([os.environ["WHITTED"], "render", os.path.join(out, "view.json"), "-o", os.path.join(out, "cli.exr")])
 cli = oiio.ImageBuf(os.path.join(out, "cli.exr")).get_pixels(oiio.FLOAT)[:, :, :3]
 drawn = np.load(os.path.join(out, "view.npy"))
 assert drawn.shape == (48, 64, 4) and cli.shape == (48, 64, 3), (drawn.shape, cli.shape)

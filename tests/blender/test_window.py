@@ -4,33 +4,29 @@ view in Rendered shading with Whitted; its pixels on screen equal `whitted rende
 viewport rendered, through the Standard view transform (sRGB), within 8-bit display quantisation; leaving
 Rendered shading ends the render thread. Fails (does not skip) without Xvfb or a GL context.
 Usage: test_window.py [SCREENSHOT_COPY]"""
-import json, os, shutil, subprocess, sys, tempfile
+import json, os, shutil, sys, tempfile
 import numpy as np
-if shutil.which("blender") is None:
-    print("SKIPPED: blender is not installed (apt-get install blender)"); sys.exit(77)
-if os.environ.get("WHITTED_TEST_SANITIZED"):
-    print("SKIPPED: sanitizer build: Blender cannot load the ASan-built whitted module; "
-          "run in the plain build (scripts/test)"); sys.exit(77)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from headless import fail, require_blender, run  # noqa: E402  (tests/blender/headless.py)
+require_blender()
 if shutil.which("xvfb-run") is None or shutil.which("Xvfb") is None:
-    sys.exit("FAIL: xvfb-run/Xvfb not installed (apt-get install xvfb xauth): the window test cannot run")
+    fail("xvfb-run/Xvfb not installed (apt-get install xvfb xauth): the window test cannot run")
 import OpenImageIO as oiio
 here = os.path.dirname(os.path.abspath(__file__))
 out = tempfile.mkdtemp(prefix="whitted-blender-window-")
 start = os.path.join(out, "start.blend")  # opening a file: no splash screen over the view
-subprocess.run(["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr",
-                f"import bpy; bpy.ops.wm.save_as_mainfile(filepath={start!r})"], check=True, capture_output=True)
-r = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x800x24", "blender", "--factory-startup", start,
-                    "--python-exit-code", "1", "--python", os.path.join(here, "window_checks.py"), "--", out],
-                   capture_output=True, text=True, timeout=240)
+run(["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr",
+     f"import bpy; bpy.ops.wm.save_as_mainfile(filepath={start!r})"])
+r = run(["xvfb-run", "-a", "-s", "-screen 0 1280x800x24", "blender", "--factory-startup", start,
+         "--python-exit-code", "1", "--python", os.path.join(here, "window_checks.py"), "--", out], expect=None, timeout=240)
 result = os.path.join(out, "result.json")
 if r.returncode != 0 or not os.path.exists(result):
     print(r.stdout[-3000:], r.stderr[-3000:])
-    sys.exit(f"FAIL: windowed Blender exited {r.returncode} without a result (no X display or GL context?)")
+    fail(f"windowed Blender exited {r.returncode} without a result (no X display or GL context?)")
 res = json.load(open(result))
 assert "error" not in res, res["error"]
 assert res["gl_renderer"], res
-subprocess.run([os.environ["WHITTED"], "render", os.path.join(out, "view.json"), "-o", os.path.join(out, "cli.exr")],
-               check=True, capture_output=True)
+run([os.environ["WHITTED"], "render", os.path.join(out, "view.json"), "-o", os.path.join(out, "cli.exr")])
 screen = oiio.ImageBuf(os.path.join(out, "screen.png")).get_pixels(oiio.UINT8)[:, :, :3].astype(int)
 rg = res["region"]
 assert screen.shape[:2] == (res["window"]["height"], res["window"]["width"]), (screen.shape, res["window"])
@@ -56,7 +52,7 @@ within = (d <= 2).mean()
 no_cm = np.abs(view - np.rint(255 * c).astype(int)).max(axis=2)[mask]
 if not (within >= 0.999 and d.max() <= 4):
     bad = np.argwhere((np.abs(view - expect).max(axis=2) > 4) & mask)
-    sys.exit(f"FAIL: {100 * within:.3f}% within 2 codes, max {d.max()}; {len(bad)} pixels > 4, first (row, col) "
+    fail(f"{100 * within:.3f}% within 2 codes, max {d.max()}; {len(bad)} pixels > 4, first (row, col) "
              f"{bad[:5].tolist()} of the view")
 assert (no_cm > 8).mean() > 0.5, "the drawn pixels look linear: the display transform was not applied"
 assert res["alive_before"] and not res["alive_after_solid"], res

@@ -39,6 +39,9 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import fail, read_pixels, run, skip  # noqa: E402  (tests/harness.py)
+
 MIRRORS = """version: 1
 camera: {{ eye: [0, 3, 9], look_at: [0, 0.5, 0], fov: 55 }}
 image: {{ width: {w}, height: {h}, samples: {s}, background: [0.1, 0.1, 0.15] }}
@@ -57,11 +60,6 @@ objects:
     for x in range(-4, 5, 2) for z in range(-4, 3, 2))
 
 OLD_BYTES = b"the previous render: must survive a distributed render that fails\n" * 100
-
-
-def fail(message):
-    print("FAIL: " + message)
-    sys.exit(1)
 
 
 def mpirun_prefix(ranks, btl=None):
@@ -83,17 +81,6 @@ def mpi_env():
     return env
 
 
-def read_exr(path):
-    import numpy
-    import OpenImageIO as oiio
-    image = oiio.ImageInput.open(path)
-    if image is None:
-        fail(f"cannot read {path}: {oiio.geterror()}")
-    pixels = image.read_image(format="float")
-    image.close()
-    return numpy.asarray(pixels)
-
-
 def identical(whitted, directory):
     import numpy
     problems = []
@@ -104,25 +91,22 @@ def identical(whitted, directory):
         reference = os.path.join(directory, f"{name}-one-process.exr")
         env = mpi_env()
         env["WHITTED_MPI"] = "0"
-        run = subprocess.run([whitted, "render", scene, "-o", reference, "-q"], env=env, capture_output=True,
-                             text=True)
-        if run.returncode != 0:
-            fail(f"one-process render of {name}: exit {run.returncode}: {run.stderr}")
-        expected = read_exr(reference)
+        run([whitted, "render", scene, "-o", reference, "-q"], env=env)
+        expected = read_pixels(reference)
         for ranks, threads, btl in [(1, 2, None), (2, 1, None), (3, 1, None), (4, 1, None), (2, 1, "self,tcp")]:
             label = f"{name}, {ranks} rank(s)" + (f", btl {btl}" if btl else "")
             output = os.path.join(directory, f"{name}-{ranks}-{btl or 'default'}.exr")
             command = mpirun_prefix(ranks, btl) + [whitted, "render", scene, "-o", output, "-t", str(threads)]
             started = time.monotonic()
-            run = subprocess.run(command, env=mpi_env(), capture_output=True, text=True, timeout=300)
+            result = run(command, env=mpi_env(), expect=None, timeout=300)
             seconds = time.monotonic() - started
-            if run.returncode != 0:
-                problems.append(f"{label}: exit {run.returncode}: {run.stderr.strip()[-2000:]}")
+            if result.returncode != 0:
+                problems.append(f"{label}: exit {result.returncode}: {result.stderr.strip()[-2000:]}")
                 continue
-            if f"rendered by {ranks} MPI rank(s)" not in run.stderr:
-                problems.append(f"{label}: the render did not say it ran on {ranks} ranks: {run.stderr.strip()}")
+            if f"rendered by {ranks} MPI rank(s)" not in result.stderr:
+                problems.append(f"{label}: the render did not say it ran on {ranks} ranks: {result.stderr.strip()}")
                 continue
-            got = read_exr(output)
+            got = read_pixels(output)
             if got.shape != expected.shape:
                 problems.append(f"{label}: shape {got.shape}, expected {expected.shape}")
                 continue
@@ -136,11 +120,11 @@ def identical(whitted, directory):
         x, y, cw, ch = 45, 70, 200, 101
         output = os.path.join(directory, f"{name}-crop.exr")
         command = mpirun_prefix(3) + [whitted, "render", scene, "-o", output, "-t", "1", "--crop", f"{x},{y},{cw},{ch}"]
-        run = subprocess.run(command, env=mpi_env(), capture_output=True, text=True, timeout=300)
-        if run.returncode != 0:
-            problems.append(f"{name}, --crop on 3 ranks: exit {run.returncode}: {run.stderr.strip()[-2000:]}")
+        result = run(command, env=mpi_env(), expect=None, timeout=300)
+        if result.returncode != 0:
+            problems.append(f"{name}, --crop on 3 ranks: exit {result.returncode}: {result.stderr.strip()[-2000:]}")
             continue
-        got, window = read_exr(output), expected[y:y + ch, x:x + cw]
+        got, window = read_pixels(output), expected[y:y + ch, x:x + cw]
         if got.shape != window.shape or not numpy.array_equal(got, window):
             problems.append(f"{name}, --crop on 3 ranks: not the one-process render's window ({got.shape})")
         print(f"{name}, --crop {x},{y},{cw},{ch} on 3 ranks: {'identical' if not problems else 'see above'}")
@@ -301,9 +285,7 @@ def job_control(whitted, directory, problems):
     reference = os.path.join(directory, "resumed-one-process.exr")
     env = mpi_env()
     env["WHITTED_MPI"] = "0"
-    run = subprocess.run([whitted, "render", scene, "-o", reference, "-q"], env=env, capture_output=True, text=True)
-    if run.returncode != 0:
-        fail(f"one-process render for the job-control check: exit {run.returncode}: {run.stderr}")
+    run([whitted, "render", scene, "-o", reference, "-q"], env=env)
     output = os.path.join(directory, "resumed.exr")
     started = time.monotonic()
     process = subprocess.Popen(mpirun_prefix(2) + [whitted, "render", scene, "-o", output, "-t", "1", "-q"],
@@ -331,14 +313,14 @@ def job_control(whitted, directory, problems):
     if process.returncode != 0:
         problems.append(f"job control: the resumed render failed (exit {process.returncode}): {text.strip()}")
         return
-    got, expected = read_exr(output), read_exr(reference)
+    got, expected = read_pixels(output), read_pixels(reference)
     if got.shape != expected.shape or numpy.any(got != expected):
         problems.append("job control: the resumed render differs from the one-process render")
 
 
 def startup(whitted, directory):
     problems = []
-    ldd = subprocess.run(["ldd", whitted], capture_output=True, text=True)
+    ldd = run(["ldd", whitted], expect=None)
     if "libmpi" in ldd.stdout:
         problems.append("whitted links libmpi:\n" + ldd.stdout)
     scene = os.path.join(directory, "small.yaml")
@@ -350,18 +332,18 @@ def startup(whitted, directory):
         if key.startswith(("OMPI_", "PMIX_", "PMI_", "SLURM_")) or key == "WHITTED_MPI":
             del env[key]
     for command in ([whitted, "--version"], [whitted, "render", scene, "-o", output, "-q"]):
-        run = subprocess.run(command, env=env, capture_output=True, text=True)
-        if run.returncode != 0:
-            problems.append(f"{' '.join(command)}: exit {run.returncode}")
-        if "libmpi" in run.stderr or "libwhitted_mpi" in run.stderr:
+        result = run(command, env=env, expect=None)
+        if result.returncode != 0:
+            problems.append(f"{' '.join(command)}: exit {result.returncode}")
+        if "libmpi" in result.stderr or "libwhitted_mpi" in result.stderr:
             problems.append(f"{' '.join(command)} loaded MPI without being started by mpirun")
     env = mpi_env()
     env["LD_DEBUG"] = "files"
-    run = subprocess.run(mpirun_prefix(1) + [whitted, "render", scene, "-o", output, "-q"], env=env,
-                         capture_output=True, text=True, timeout=120)
-    if run.returncode != 0:
-        problems.append(f"mpirun -np 1 whitted render: exit {run.returncode}: {run.stderr[-2000:]}")
-    if "libwhitted_mpi.so" not in run.stderr or "libmpi.so" not in run.stderr:
+    result = run(mpirun_prefix(1) + [whitted, "render", scene, "-o", output, "-q"], env=env, expect=None,
+                 timeout=120)
+    if result.returncode != 0:
+        problems.append(f"mpirun -np 1 whitted render: exit {result.returncode}: {result.stderr[-2000:]}")
+    if "libwhitted_mpi.so" not in result.stderr or "libmpi.so" not in result.stderr:
         problems.append("under mpirun the MPI plug-in and libmpi were not loaded")
     if problems:
         fail("\n  ".join(problems))
@@ -383,10 +365,10 @@ def sweep(whitted, directory, source_dir):
     for label, command in (("serial", [validate]), ("mpi", mpirun_prefix(3) + [validate, "--mpi"])):
         out = os.path.join(directory, label)
         started = time.monotonic()
-        run = subprocess.run(command + ["--out", out] + scenes, env=env, capture_output=True, text=True, timeout=600)
+        result = run(command + ["--out", out] + scenes, env=env, expect=None, timeout=600)
         seconds = time.monotonic() - started
-        print(f"{label} ({seconds:.1f}s, exit {run.returncode}):\n{run.stdout}{run.stderr[-3000:]}")
-        verdicts = [line for line in run.stdout.splitlines() if re.match(r"\[\d+/\d+\] ", line)]
+        print(f"{label} ({seconds:.1f}s, exit {result.returncode}):\n{result.stdout}{result.stderr[-3000:]}")
+        verdicts = [line for line in result.stdout.splitlines() if re.match(r"\[\d+/\d+\] ", line)]
         with open(os.path.join(out, "index.html")) as f:
             rows = [line for line in f if line.startswith("<tr class=")]
         texts = {}
@@ -394,7 +376,7 @@ def sweep(whitted, directory, source_dir):
             with open(os.path.join(out, name + ".txt")) as f:
                 # The check's output names the report directory, which differs between the runs.
                 texts[name] = f.read().replace(out, "OUT")
-        runs[label] = (run.returncode, verdicts, rows, texts, run.stderr)
+        runs[label] = (result.returncode, verdicts, rows, texts, result.stderr)
     problems = []
     serial, mpi = runs["serial"], runs["mpi"]
     if len(serial[1]) != len(scenes):
@@ -425,8 +407,7 @@ def hosts(whitted, directory):
     import numpy
     ip = shutil.which("ip")
     if not ip:
-        print("SKIPPED: no `ip` command (apt-get install iproute2; scripts/setup --with-test-tools does)")
-        sys.exit(77)
+        skip("no `ip` command (apt-get install iproute2; scripts/setup --with-test-tools does)")
     # The namespaces outlive this process: a SIGTERM (ctest's timeout, Ctrl-C) must reach `finally`.
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     tag = str(os.getpid())
@@ -435,16 +416,15 @@ def hosts(whitted, directory):
     addresses = ["10.77.0.1", "10.77.0.2"]
 
     def ip_run(*args, check=True):
-        run = subprocess.run([ip, *args], capture_output=True, text=True)
-        if check and run.returncode != 0:
-            raise RuntimeError(f"ip {' '.join(args)}: {run.stderr.strip()}")
-        return run
+        result = run([ip, *args], expect=None)
+        if check and result.returncode != 0:
+            raise RuntimeError(f"ip {' '.join(args)}: {result.stderr.strip()}")
+        return result
 
     try:
         ip_run("netns", "add", ns[0])
     except RuntimeError as e:
-        print(f"SKIPPED: cannot create a network namespace (needs CAP_NET_ADMIN): {e}")
-        sys.exit(77)
+        skip(f"cannot create a network namespace (needs CAP_NET_ADMIN): {e}")
     try:
         try:
             ip_run("netns", "add", ns[1])
@@ -456,8 +436,7 @@ def hosts(whitted, directory):
         except RuntimeError as e:
             # e.g. in a chroot whose / is no mount point, `ip -n` cannot make its mounts private
             # ("mount --make-rslave /" failed): this host cannot give the namespaces a network.
-            print(f"SKIPPED: cannot set up the two namespaces' network here: {e}")
-            sys.exit(77)
+            skip(f"cannot set up the two namespaces' network here: {e}")
         agent = os.path.join(os.path.dirname(os.path.abspath(__file__)), "netns_agent.sh")
         env = mpi_env()
         env["WHITTED_NETNS_MAP"] = " ".join(f"{a}={n}" for a, n in zip(addresses, ns))
@@ -467,10 +446,8 @@ def hosts(whitted, directory):
             f.write(MIRRORS.format(w=517, h=389, s=2))
         reference = os.path.join(directory, "one-process.exr")
         one = dict(env, WHITTED_MPI="0")
-        run = subprocess.run([whitted, "render", scene, "-o", reference, "-q"], env=one, capture_output=True, text=True)
-        if run.returncode != 0:
-            fail(f"one-process render: exit {run.returncode}: {run.stderr}")
-        expected = read_exr(reference)
+        run([whitted, "render", scene, "-o", reference, "-q"], env=one)
+        expected = read_pixels(reference)
         for per_host in (1, 2):
             ranks = 2 * per_host
             mpirun = [ip, "netns", "exec", ns[0], shutil.which("mpirun") or "mpirun", "--oversubscribe",
@@ -478,8 +455,7 @@ def hosts(whitted, directory):
                       "--map-by", "node", "--mca", "plm_rsh_agent", agent, "--mca", "btl", "tcp,self",
                       "--mca", "btl_tcp_if_include", "10.77.0.0/24", "--mca", "oob_tcp_if_include", "10.77.0.0/24"]
             # Where each rank runs: the same launch, `ip netns identify` in place of whitted.
-            where = subprocess.run(mpirun + [ip, "netns", "identify"], env=env, capture_output=True, text=True,
-                                   timeout=120)
+            where = run(mpirun + [ip, "netns", "identify"], env=env, expect=None, timeout=120)
             names = sorted(where.stdout.split())
             print(f"{per_host} rank(s) per host: namespaces of the ranks {names} (exit {where.returncode})")
             if where.returncode != 0 or names != sorted(ns * per_host):
@@ -487,14 +463,14 @@ def hosts(whitted, directory):
                 continue
             output = os.path.join(directory, f"hosts-{per_host}.exr")
             started = time.monotonic()
-            run = subprocess.run(mpirun + [whitted, "render", scene, "-o", output, "-t", "1"], env=env,
-                                 capture_output=True, text=True, timeout=300)
-            print(f"{per_host} rank(s) per host: exit {run.returncode} after {time.monotonic() - started:.2f}s: "
-                  f"{run.stderr.strip()[-1500:]}")
-            if run.returncode != 0 or f"rendered by {ranks} MPI rank(s)" not in run.stderr:
+            result = run(mpirun + [whitted, "render", scene, "-o", output, "-t", "1"], env=env, expect=None,
+                         timeout=300)
+            print(f"{per_host} rank(s) per host: exit {result.returncode} after {time.monotonic() - started:.2f}s: "
+                  f"{result.stderr.strip()[-1500:]}")
+            if result.returncode != 0 or f"rendered by {ranks} MPI rank(s)" not in result.stderr:
                 problems.append(f"{per_host}/host: the render failed or did not run on {ranks} ranks")
                 continue
-            got = read_exr(output)
+            got = read_pixels(output)
             if got.shape != expected.shape or numpy.any(got != expected):
                 problems.append(f"{per_host}/host: pixels differ from the one-process render")
         if problems:
