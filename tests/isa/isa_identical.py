@@ -3,10 +3,14 @@
 """Renders one scene under every Embree instruction set this CPU can run, with 1 and 2 threads,
 and fails unless every image is bit-identical to the one Embree's own choice gives.
 
-    isa_identical.py WHITTED SCENE OUT_DIR [--two-threads-only]
+    isa_identical.py WHITTED SCENE OUT_DIR [--two-threads-only] [--povray-rule]
 
 --two-threads-only (the sanitizer build, where each render is ten times slower): each
 instruction set with 2 threads only, which still runs every packet width and the threaded path.
+--povray-rule: also under `render.intersection: povray`, the rule `whitted check` renders
+with (each instruction set with 2 threads against the native render under that rule), so that
+with pov.SCENE, which checks the native image against POV-Ray, every instruction set is
+checked against POV-Ray under the rule the cross-check uses.
 
 Embree runs different code for each instruction set (SSE2 ... AVX-512: 4-, 8- or 16-wide
 packets, with or without FMA), and a CPU runs only the widest it has unless told otherwise; so
@@ -21,38 +25,32 @@ for byte (the header before them holds the render time, which differs).
 
 import os
 import struct
-import subprocess
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, fail, read_exr_header, run  # noqa: E402  (tests/harness.py)
 
 ISAS = ["sse2", "sse4.2", "avx", "avx2", "avx512"]
 UNSUPPORTED = "this CPU cannot run Embree's"
 
 
-def render(whitted, scene, out, isa, threads):
+def render(whitted, scene, out, isa, threads, rule):
     env = dict(os.environ)
     env.pop("WHITTED_EMBREE_ISA", None)
     if isa:
         env["WHITTED_EMBREE_ISA"] = isa
     cmd = [whitted, "render", "-q", scene, "-o", out, "--threads", str(threads), "--exr-compression", "none"]
-    return subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=120)
-
-
-def exr_size(path):
-    """Width and height from the header's dataWindow (box2i: xmin ymin xmax ymax)."""
-    data = open(path, "rb").read()
-    key = b"dataWindow\0box2i\0"
-    at = data.find(key)
-    if at < 0:
-        raise ValueError(f"{path}: no dataWindow attribute")
-    at += len(key) + 4  # attribute size
-    xmin, ymin, xmax, ymax = struct.unpack_from("<4i", data, at)
-    return xmax - xmin + 1, ymax - ymin + 1, ymin
+    if rule == "povray":  # else the scene's own render.intersection
+        cmd += ["--intersection", "povray"]
+    return run(cmd, expect=None, timeout=120, env=env)
 
 
 def scanlines(path):
     """The rows of an uncompressed 3-channel float EXR, as the bytes of its chunks, checked."""
-    width, height, ymin = exr_size(path)
     data = open(path, "rb").read()
+    attributes, _ = read_exr_header(data, path)
+    xmin, ymin, xmax, ymax = struct.unpack("<4i", attributes["dataWindow"][1])
+    width, height = xmax - xmin + 1, ymax - ymin + 1
     row = 3 * 4 * width
     chunk = 8 + row
     start = len(data) - height * chunk
@@ -77,48 +75,49 @@ def first_difference(a, b, width):
 
 
 def main():
-    if len(sys.argv) not in (4, 5) or (len(sys.argv) == 5 and sys.argv[4] != "--two-threads-only"):
+    options = sys.argv[4:]
+    if len(sys.argv) < 4 or any(o not in ("--two-threads-only", "--povray-rule") for o in options):
         print(__doc__, file=sys.stderr)
         return 2
     whitted, scene, out_dir = sys.argv[1:4]
-    thread_counts = (2,) if len(sys.argv) == 5 else (1, 2)
+    thread_counts = (2,) if "--two-threads-only" in options else (1, 2)
     os.makedirs(out_dir, exist_ok=True)
     name = os.path.splitext(os.path.basename(scene))[0]
-
-    base_path = os.path.join(out_dir, f"{name}.native.t2.exr")
-    result = render(whitted, scene, base_path, "", 2)
-    if result.returncode != 0:
-        print(f"FAIL: native render exited {result.returncode}:\n{result.stderr}", file=sys.stderr)
-        return 1
-    base, width, height = scanlines(base_path)
-
-    ran, skipped, failures = ["native t2"], [], []
-    variants = [("", t) for t in thread_counts if t != 2] + [(isa, t) for isa in ISAS for t in thread_counts]
-    for isa, threads in variants:
-        label = f"{isa or 'native'} t{threads}"
-        path = os.path.join(out_dir, f"{name}.{isa or 'native'}.t{threads}.exr")
-        result = render(whitted, scene, path, isa, threads)
-        if result.returncode == 2 and UNSUPPORTED in result.stderr:
-            if isa not in skipped:
-                skipped.append(isa)
-            continue
+    failures = Failures()
+    # The scene's own rule with every variant; POV-Ray's with 2 threads (the rules differ in how a
+    # hit is decided, not in how the tiles are shared among threads, which the first covers).
+    rules = [("scene", thread_counts)] + ([("povray", (2,))] if "--povray-rule" in options else [])
+    for rule, counts in rules:
+        base_path = os.path.join(out_dir, f"{name}.{rule}.native.t2.exr")
+        result = render(whitted, scene, base_path, "", 2, rule)
         if result.returncode != 0:
-            failures.append(f"{label}: exited {result.returncode}: {result.stderr.strip()[-600:]}")
-            continue
-        pixels, _, _ = scanlines(path)
-        ran.append(label)
-        if pixels != base:
-            failures.append(f"{label}: pixels differ from native t2 ({first_difference(pixels, base, width)})")
+            fail(f"native render ({rule} rule) exited {result.returncode}:\n{result.stderr}")
+        base, width, height = scanlines(base_path)
 
-    print(f"{name} ({width}x{height}): ran {', '.join(ran)}")
-    if skipped:
-        print(f"not run, this CPU lacks them: {', '.join(skipped)}")
-    for failure in failures:
-        print(f"FAIL: {failure}", file=sys.stderr)
-    if len(ran) < 3:
-        print("FAIL: fewer than two variants besides the base ran; nothing was compared", file=sys.stderr)
-        return 1
-    return 1 if failures else 0
+        ran, skipped = ["native t2"], []
+        variants = [("", t) for t in counts if t != 2] + [(isa, t) for isa in ISAS for t in counts]
+        for isa, threads in variants:
+            label = f"{rule} rule, {isa or 'native'} t{threads}"
+            path = os.path.join(out_dir, f"{name}.{rule}.{isa or 'native'}.t{threads}.exr")
+            result = render(whitted, scene, path, isa, threads, rule)
+            if result.returncode == 2 and UNSUPPORTED in result.stderr:
+                if isa not in skipped:
+                    skipped.append(isa)
+                continue
+            if not failures.require(result.returncode == 0,
+                                    f"{label}: exited {result.returncode}: {result.stderr.strip()[-600:]}"):
+                continue
+            pixels, _, _ = scanlines(path)
+            ran.append(f"{isa or 'native'} t{threads}")
+            failures.require(pixels == base,
+                             f"{label}: pixels differ from native t2 ({first_difference(pixels, base, width)})")
+
+        print(f"{name} ({width}x{height}), {rule} rule: ran {', '.join(ran)}")
+        if skipped:
+            print(f"not run, this CPU lacks them: {', '.join(skipped)}")
+        failures.require(len(ran) >= 3, f"{rule} rule: fewer than two variants besides the base ran; "
+                                        "nothing was compared")
+    failures.finish()
 
 
 if __name__ == "__main__":

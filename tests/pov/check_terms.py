@@ -16,8 +16,10 @@ Like the rest of the pov tier, this needs POV-Ray and fails without it."""
 import os
 import re
 import shutil
-import subprocess
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import fail, run  # noqa: E402  (tests/harness.py)
 
 WRAPPER = r'''#!/usr/bin/python3
 # Runs POV-Ray on the .ini given; brightens the image when the scene has only the light at <3, 3, 5>.
@@ -42,42 +44,37 @@ def main():
     scene = os.path.join(scene_dir, "phong_blinn_mixed.yaml")
     terms = ["ambient", "diffuse", "specular", "light 1", "light 2"]
 
-    result = subprocess.run([whitted, "check", scene, "--terms", "-q"], capture_output=True, text=True)
-    if result.returncode != 0:
-        sys.exit(f"FAIL: check --terms exited {result.returncode}:\n{result.stdout}{result.stderr}")
+    result = run([whitted, "check", scene, "--terms", "-q"])
     for term in terms:
         if not re.search(rf"^PASS .*\[{term} only\]", result.stdout, re.M):
-            sys.exit(f"FAIL: no PASS line for the term '{term}':\n{result.stdout}")
+            fail(f"no PASS line for the term '{term}':\n{result.stdout}")
     last = result.stdout.strip().splitlines()[-1]
     if not last.startswith("whitted check --terms") or "PASS" not in last or ", ".join(terms) not in last:
-        sys.exit(f"FAIL: last line should say every term passed: {last}")
+        fail(f"last line should say every term passed: {last}")
     print(f"ok real POV-Ray: {last}")
 
     povray = shutil.which("povray")
     if not povray:
-        sys.exit("FAIL: povray not found")
+        fail("povray not found")
     wrapper = os.path.join(out_dir, "povray")
     with open(wrapper, "w") as f:
         f.write(WRAPPER.replace("POVRAY", repr(povray)))
     os.chmod(wrapper, 0o755)
     env = dict(os.environ, WHITTED_POVRAY=wrapper)
-    result = subprocess.run([whitted, "check", scene, "--terms", "-q"], capture_output=True, text=True, env=env)
-    if result.returncode != 1:
-        sys.exit(f"FAIL: with light 2 brightened check --terms exited {result.returncode}:\n"
-                 f"{result.stdout}{result.stderr}")
+    result = run([whitted, "check", scene, "--terms", "-q"], expect=1, env=env)
     last = result.stdout.strip().splitlines()[-1]
     want = "FAIL: light 2 disagrees with POV-Ray (ambient, diffuse, specular, light 1 agree)"
     if want not in last:
-        sys.exit(f"FAIL: the verdict should be '{want}', got: {last}")
+        fail(f"the verdict should be '{want}', got: {last}")
     if not re.search(r"^FAIL .*\[light 2 only\]", result.stdout, re.M):
-        sys.exit(f"FAIL: no FAIL line for light 2:\n{result.stdout}")
+        fail(f"no FAIL line for light 2:\n{result.stdout}")
     print(f"ok light 2 made to disagree: {last}")
 
     meshes = os.path.join(scene_dir, "..", "..", "examples", "meshes", "meshes.yaml")
-    result = subprocess.run([whitted, "check", meshes, "--terms", "-q"], capture_output=True, text=True)
+    result = run([whitted, "check", meshes, "--terms", "-q"], expect=2)
     want = "meshes.yaml:49:9: check --terms: this mesh takes its materials from the MTL file of 'icosphere.obj'"
-    if result.returncode != 2 or want not in result.stderr:
-        sys.exit(f"FAIL: MTL materials: exit {result.returncode}, stderr: {result.stderr}")
+    if want not in result.stderr:
+        fail(f"MTL materials: stderr: {result.stderr}")
     print("ok MTL materials refused: exit 2 with the object's place")
 
 
