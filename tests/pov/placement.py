@@ -22,6 +22,9 @@ import numpy as np
 import whitted
 import yaml
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures  # noqa: E402  (tests/harness.py)
+
 DIRECTION = (1.0, -0.61, 0.37)
 # Not powers of two: a dyadic factor moves a float coordinate exactly, and hides what rounding does.
 TRANSLATIONS = (170.0, 610.0, 2.3e3, 8.9e3, 3.7e4, 7.9e4, 2.9e5, 1.1e6)
@@ -72,7 +75,7 @@ def main():
     with open(source) as f:
         text = f.read()
     origin = whitted.render(whitted.load(source), threads=1)
-    failures = []
+    failures = Failures()
     cases = [(f"translate_{t:g}", dict(translate=[t * c for c in DIRECTION])) for t in TRANSLATIONS]
     cases += [(f"scale_{k:g}", dict(scale=k)) for k in SCALES]
     for name, how in cases:
@@ -81,14 +84,12 @@ def main():
         with open(path, "w") as f:
             yaml.dump(scene, f, Dumper=yaml.CSafeDumper, sort_keys=True)
         passed, summary = compare(origin, whitted.render(whitted.load(path), threads=1))
-        print(f"{name}: {'PASS' if passed else 'FAIL'} {summary}")
-        if not passed:
-            failures.append(name)
-    if failures:
-        print(f"placement: {os.path.basename(source)} changes when {', '.join(failures)}", file=sys.stderr)
-        return 1
-    return 0
+        failures.check(passed, f"{name}: {summary}")
+    if failures.messages:
+        changed = ", ".join(m.split(":")[0] for m in failures.messages)
+        print(f"placement: {os.path.basename(source)} changes when {changed}", file=sys.stderr)
+    failures.finish()
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

@@ -5,8 +5,11 @@ writes). Pixels are addressed as (x, y, channel), column from the left, row from
 
 import os
 import struct
-import subprocess
+import sys
 import zlib
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import run  # noqa: E402  (tests/harness.py)
 
 
 def _chunk(kind, data):
@@ -61,5 +64,5 @@ def exr(oiiotool, path, width, height, value, overrides=None, channels=3):
         raise SystemExit("oiiotool (OpenImageIO's tool; Debian: openimageio-tools) is needed and was not found")
     source = path + ".pfm"
     pfm(source, width, height, value, overrides, channels)
-    subprocess.run([oiiotool, source, "-d", "float", "-o", path], check=True)
+    run([oiiotool, source, "-d", "float", "-o", path])
     os.remove(source)
