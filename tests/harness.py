@@ -52,11 +52,12 @@ def run(command, expect=0, timeout=600, text=True, **kwargs):
 
 
 def _tail(stream, size=3000):
+    """The last SIZE characters (None: all) of a captured stream, as text."""
     if stream is None:
         return ""
     if isinstance(stream, bytes):
         stream = stream.decode("utf-8", "replace")
-    return stream[-size:]
+    return stream if size is None else stream[-size:]
 
 
 def fresh_folder(path):
@@ -104,14 +105,15 @@ class Failures:
         """Runs COMMAND, which must refuse: a failed check unless it exits with EXPECT and its
         standard error holds every one of FRAGMENTS. Returns the CompletedProcess."""
         result = run(command, expect=None, timeout=timeout, **kwargs)
-        stderr = _tail(result.stderr)
+        stderr = _tail(result.stderr, None)
         self.require(result.returncode == expect, f"{what}: exit {result.returncode}, expected {expect}\n{stderr}")
         for fragment in fragments:
             self.require(fragment in stderr, f"{what}: the message does not say '{fragment}': {stderr!r}")
         return result
 
     def finish(self, passed=None):
-        """Ends the test: failed (exit 1) if any check failed, else passed, printing PASSED."""
+        """Ends the test: failed (exit 1) if any check failed, else passed (exit 0), then printing
+        PASSED (a line saying what passed) if given."""
         if self.messages:
             print(f"{len(self.messages)} problem(s)")
             sys.exit(1)
