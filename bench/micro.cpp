@@ -33,8 +33,8 @@ objects:
   - { type: plane, point: [0, 0, 0], normal: [0, 1, 0], material: { kd: 0.55, ka: 0.03, km: 0.35 } }
 )";
     SceneDescription description = parse_scene_text(yaml, "bench.yaml");
-    ObjectDescription mesh;
-    mesh.type = ObjectType::mesh;
+    ObjectDescription object;
+    MeshShape& mesh = object.shape.emplace<MeshShape>();
     MaterialDescription material;
     material.kd.value = {0.6, 0.35, 0.2};
     material.ks.value = Color(0.5);
@@ -42,7 +42,7 @@ objects:
     material.km.value = Color(0.1);
     MaterialReference reference;
     reference.inline_ = material;
-    mesh.material = reference;
+    object.material = reference;
     for (int i = 0; i < major; ++i) {
         const double u = 2 * std::numbers::pi * i / major;
         for (int j = 0; j < minor; ++j) {
@@ -59,7 +59,7 @@ objects:
             mesh.triangles.push_back({a, d, c});
             mesh.triangle_where.resize(mesh.triangles.size());
         }
-    description.objects.push_back(mesh);
+    description.objects.push_back(std::move(object));
     return validate_scene(description);
 }
 

@@ -24,6 +24,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <span>
 #include <stdexcept>
 
 namespace whitted::pov {
@@ -149,14 +150,12 @@ public:
         // The cylinders' and cones' caps as the file gives them: the Scene keeps the base, the
         // unit axis and the height, whose sum rounds. Prototypes hold no cones, so the
         // description's, in file order, are the Scene's.
-        std::function<void(const std::vector<ObjectDescription>&)> caps = [&](const auto& list) {
-            for (const ObjectDescription& object : list) {
-                if (object.type == ObjectType::cylinder || object.type == ObjectType::cone)
-                    m_caps.push_back(object.cap.value);
-                caps(object.children);
-            }
-        };
-        caps(description.objects);
+        for_each_object(description.objects, [&](const ObjectDescription& object) {
+            if (const auto* cylinder = std::get_if<CylinderShape>(&object.shape))
+                m_caps.push_back(cylinder->cap.value);
+            else if (const auto* cone = std::get_if<ConeShape>(&object.shape))
+                m_caps.push_back(cone->cap.value);
+        });
         // Each object's place in the list of its kind (objects are numbered from 1, file order).
         m_shape.assign(scene.objects.size(), 0);
         const auto number = [&](const auto& shapes) {
@@ -383,16 +382,15 @@ double radiance_upper_bound(const SceneDescription& d) {
     Color light_sum(0.0);
     for (const auto& light : d.lights) light_sum += light.intensity.value;
     std::vector<MaterialDescription> materials = d.materials;
-    std::function<void(const std::vector<ObjectDescription>&)> collect = [&](const auto& objects) {
-        for (const auto& object : objects) {
-            if (object.material && object.material->inline_) materials.push_back(*object.material->inline_);
-            collect(object.children);
-        }
+    // Meshes from files bring their own MTL materials; without reading them, assume the worst.
+    bool has_mtl = false;
+    const auto collect = [&](const ObjectDescription& object) {
+        if (object.material && object.material->inline_) materials.push_back(*object.material->inline_);
+        const auto* mesh = std::get_if<MeshShape>(&object.shape);
+        if (mesh && mesh->file.given && !object.material) has_mtl = true;
     };
-    collect(d.objects);
-    std::vector<ObjectDescription> prototype_objects;
-    for (const auto& prototype : d.prototypes) prototype_objects.push_back(prototype.object);
-    collect(prototype_objects);
+    for_each_object(d.objects, collect);
+    for (const auto& prototype : d.prototypes) for_each_object(std::span(&prototype.object, 1), collect);
     double local = 0, mirror = 0;
     for (const auto& m : materials) {
         local = std::max(local, max_channel(m.ka.value * d.ambient.value + (m.kd.value + m.ks.value) * light_sum));
@@ -401,14 +399,7 @@ double radiance_upper_bound(const SceneDescription& d) {
         mirror = std::max(mirror, is_zero(m.kt.value) ? max_channel(m.km.value)
                                                       : std::max(1.0, max_channel(m.km.value + m.kt.value)));
     }
-    // Meshes from files bring their own MTL materials; without reading them, assume the worst.
-    std::function<bool(const std::vector<ObjectDescription>&)> has_mtl = [&](const auto& objects) {
-        for (const auto& object : objects)
-            if ((object.type == ObjectType::mesh && object.file.given && !object.material) || has_mtl(object.children))
-                return true;
-        return false;
-    };
-    if (has_mtl(d.objects) || has_mtl(prototype_objects)) return INFINITY;
+    if (has_mtl) return INFINITY;
     const double background = max_channel(d.image.background.value);
     double bound = std::max(background, local);
     for (int64_t depth = 2; depth <= d.max_depth.value; ++depth) bound = std::max(background, local + mirror * bound);
@@ -456,14 +447,11 @@ static void refuse_inexpressible(const SceneDescription& d) {
                    "no POV-Ray equivalent checked against Whitted");
     };
     for (const auto& m : d.materials) material(m);
-    std::function<void(const std::vector<ObjectDescription>&)> objects = [&](const auto& list) {
-        for (const auto& object : list) {
-            if (object.material && object.material->inline_) material(*object.material->inline_);
-            objects(object.children);
-        }
+    const auto inline_material = [&](const ObjectDescription& object) {
+        if (object.material && object.material->inline_) material(*object.material->inline_);
     };
-    objects(d.objects);
-    for (const auto& prototype : d.prototypes) objects({prototype.object});
+    for_each_object(d.objects, inline_material);
+    for (const auto& prototype : d.prototypes) for_each_object(std::span(&prototype.object, 1), inline_material);
 }
 
 static std::string write_sdl(const SceneDescription& d, const Scene& scene, const ConvertOptions& options) {

@@ -124,76 +124,79 @@ public:
         m_directory = parent.empty() ? std::filesystem::current_path(error) : std::filesystem::absolute(parent, error);
     }
 
-    std::string mesh_path(const ObjectDescription& o) const {
+    std::string mesh_path(const MeshShape& mesh) const {
         std::error_code error;
-        const std::filesystem::path file = std::filesystem::absolute(o.file_path, error);
+        const std::filesystem::path file = std::filesystem::absolute(mesh.file_path, error);
         const std::filesystem::path relative = std::filesystem::relative(file, m_directory, error);
         return error || relative.empty() ? file.string() : relative.string();
     }
 
     void objects(const std::vector<ObjectDescription>& list, const std::string& indent, std::string& out) const {
         for (const ObjectDescription& o : list) {
-            out += indent + "- type: " + to_string(o.type) + "\n";
+            out += indent + "- type: " + to_string(o.type()) + "\n";
             const std::string in = indent + "  ";
             if (!o.transform.empty()) out += in + "transform: " + transform_steps(o.transform) + "\n";
             if (o.material) {
                 out += in + "material: " +
                        (o.material->inline_ ? material_map(*o.material->inline_) : quoted(o.material->name)) + "\n";
             }
-            switch (o.type) {
-                case ObjectType::sphere:
-                    out +=
-                        in + "center: " + vec3(o.center.value) + "\n" + in + "radius: " + number(o.radius.value) + "\n";
-                    break;
-                case ObjectType::plane:
-                    out += in + "point: " + vec3(o.point.value) + "\n" + in + "normal: " + vec3(o.normal.value) + "\n";
-                    break;
-                case ObjectType::box:
-                    out += in + "min: " + vec3(o.min.value) + "\n" + in + "max: " + vec3(o.max.value) + "\n";
-                    break;
-                case ObjectType::cylinder:
-                    out += in + "base: " + vec3(o.base.value) + "\n" + in + "cap: " + vec3(o.cap.value) + "\n" + in +
-                           "radius: " + number(o.radius.value) + "\n";
-                    if (o.open.value) out += in + "open: true\n";
-                    break;
-                case ObjectType::cone:
-                    out += in + "base: " + vec3(o.base.value) + "\n" + in +
-                           "base_radius: " + number(o.base_radius.value) + "\n" + in + "cap: " + vec3(o.cap.value) +
-                           "\n" + in + "cap_radius: " + number(o.cap_radius.value) + "\n";
-                    if (o.open.value) out += in + "open: true\n";
-                    break;
-                case ObjectType::triangle:
-                case ObjectType::mesh:
-                    if (o.type == ObjectType::mesh && o.file.given) {
-                        out += in + "file: " + quoted(mesh_path(o)) + "\n";
-                        break;
-                    }
-                    out += in + "vertices: [";
-                    for (size_t i = 0; i < o.vertices.size(); ++i)
-                        out.append(i ? ", " : "").append(vec3(o.vertices[i]));
-                    out += "]\n";
-                    if (o.type == ObjectType::triangle) break;
-                    out += in + "triangles: [";
-                    for (size_t i = 0; i < o.triangles.size(); ++i)
-                        out.append(i ? ", [" : "[") += integer(o.triangles[i][0]) + ", " + integer(o.triangles[i][1]) +
-                                                       ", " + integer(o.triangles[i][2]) + "]";
-                    out += "]\n";
-                    if (!o.normals.empty()) {
-                        out += in + "normals: [";
-                        for (size_t i = 0; i < o.normals.size(); ++i)
-                            out.append(i ? ", " : "").append(vec3(o.normals[i]));
+            std::visit(
+                Overloaded{
+                    [&](const SphereShape& sphere) {
+                        out += in + "center: " + vec3(sphere.center.value) + "\n" + in +
+                               "radius: " + number(sphere.radius.value) + "\n";
+                    },
+                    [&](const PlaneShape& plane) {
+                        out += in + "point: " + vec3(plane.point.value) + "\n" + in +
+                               "normal: " + vec3(plane.normal.value) + "\n";
+                    },
+                    [&](const BoxShape& box) {
+                        out += in + "min: " + vec3(box.min.value) + "\n" + in + "max: " + vec3(box.max.value) + "\n";
+                    },
+                    [&](const CylinderShape& cylinder) {
+                        out += in + "base: " + vec3(cylinder.base.value) + "\n" + in +
+                               "cap: " + vec3(cylinder.cap.value) + "\n" + in +
+                               "radius: " + number(cylinder.radius.value) + "\n";
+                        if (cylinder.open.value) out += in + "open: true\n";
+                    },
+                    [&](const ConeShape& cone) {
+                        out += in + "base: " + vec3(cone.base.value) + "\n" + in +
+                               "base_radius: " + number(cone.base_radius.value) + "\n" + in +
+                               "cap: " + vec3(cone.cap.value) + "\n" + in +
+                               "cap_radius: " + number(cone.cap_radius.value) + "\n";
+                        if (cone.open.value) out += in + "open: true\n";
+                    },
+                    [&](const TriangleShape& triangle) { out += in + "vertices: " + vec3_list(triangle.vertices); },
+                    [&](const MeshShape& mesh) {
+                        if (mesh.file.given) {
+                            out += in + "file: " + quoted(mesh_path(mesh)) + "\n";
+                            return;
+                        }
+                        out += in + "vertices: " + vec3_list(mesh.vertices);
+                        out += in + "triangles: [";
+                        for (size_t i = 0; i < mesh.triangles.size(); ++i)
+                            out.append(i ? ", [" : "[") += integer(mesh.triangles[i][0]) + ", " +
+                                                           integer(mesh.triangles[i][1]) + ", " +
+                                                           integer(mesh.triangles[i][2]) + "]";
                         out += "]\n";
-                    }
-                    break;
-                case ObjectType::group:
-                    out += in + "objects:" + (o.children.empty() ? " []\n" : "\n");
-                    objects(o.children, in + "  ", out);
-                    break;
-                case ObjectType::instance:
-                    out += in + "prototype: " + quoted(o.prototype.value) + "\n";
-                    break;
-            }
+                        if (!mesh.normals.empty()) out += in + "normals: " + vec3_list(mesh.normals);
+                    },
+                    [&](const GroupShape& group) {
+                        out += in + "objects:" + (group.objects.empty() ? " []\n" : "\n");
+                        objects(group.objects, in + "  ", out);
+                    },
+                    [&](const InstanceShape& instance) {
+                        out += in + "prototype: " + quoted(instance.prototype.value) + "\n";
+                    }},
+                o.shape);
         }
+    }
+
+    /// `[[x, y, z], ...]` and the end of the line.
+    static std::string vec3_list(const std::vector<Vec3>& list) {
+        std::string out = "[";
+        for (size_t i = 0; i < list.size(); ++i) out.append(i ? ", " : "").append(vec3(list[i]));
+        return out + "]\n";
     }
 
 private:

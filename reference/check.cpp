@@ -302,14 +302,14 @@ namespace {
 
 template <class F>
 void for_each_material(std::vector<ObjectDescription>& objects, F&& f) {
-    for (ObjectDescription& object : objects) {
+    for_each_object(objects, [&](ObjectDescription& object) {
         if (object.material && object.material->inline_) f(*object.material->inline_);
-        if (object.type == ObjectType::mesh && object.file.given && !object.material)
+        const auto* mesh = std::get_if<MeshShape>(&object.shape);
+        if (mesh && mesh->file.given && !object.material)
             throw InputError(object.where, "check --terms: this mesh takes its materials from the MTL file of '" +
-                                               object.file.value +
+                                               mesh->file.value +
                                                "', which --terms cannot isolate; give it a 'material'");
-        for_each_material(object.children, f);
-    }
+    });
 }
 
 /// Applies f to every material of the scene, named or inline.

@@ -290,7 +290,7 @@ struct SceneBuilder::Impl {
         require_finite(where, what, {v.x, v.y, v.z});
     }
 
-    ObjectDescription& add_object(ObjectType type, const SourceLocation& where, const api::Material& m) {
+    void add_object(ObjectDescription::Shape shape, const SourceLocation& where, const api::Material& m) {
         require_finite(where, "material.ka", m.ka);
         require_finite(where, "material.kd", m.kd);
         require_finite(where, "material.ks", m.ks);
@@ -298,7 +298,7 @@ struct SceneBuilder::Impl {
         require_finite(where, "material.km", m.km);
         ObjectDescription& object = description.objects.emplace_back();
         object.where = where;
-        object.type = type;
+        object.shape = std::move(shape);
         MaterialDescription material;
         material.where = where;
         material.ka = given(vec(m.ka), where);
@@ -310,7 +310,6 @@ struct SceneBuilder::Impl {
         reference.where = where;
         reference.inline_ = std::move(material);
         object.material = std::move(reference);
-        return object;
     }
 };
 
@@ -391,9 +390,7 @@ SceneBuilder& SceneBuilder::directional_light(Vec3 direction, Vec3 intensity) {
 
 SceneBuilder& SceneBuilder::sphere(Vec3 center, double radius, const Material& material) {
     const SourceLocation where = m_impl->next();
-    ObjectDescription& object = m_impl->add_object(ObjectType::sphere, where, material);
-    object.center = given(vec(center), where);
-    object.radius = given(radius, where);
+    m_impl->add_object(SphereShape{given(vec(center), where), given(radius, where)}, where, material);
     m_impl->require_finite(where, "sphere.center", center);
     m_impl->require_finite(where, "sphere.radius", {radius});
     return *this;
@@ -401,9 +398,7 @@ SceneBuilder& SceneBuilder::sphere(Vec3 center, double radius, const Material& m
 
 SceneBuilder& SceneBuilder::plane(Vec3 point, Vec3 normal, const Material& material) {
     const SourceLocation where = m_impl->next();
-    ObjectDescription& object = m_impl->add_object(ObjectType::plane, where, material);
-    object.point = given(vec(point), where);
-    object.normal = given(vec(normal), where);
+    m_impl->add_object(PlaneShape{given(vec(point), where), given(vec(normal), where)}, where, material);
     m_impl->require_finite(where, "plane.point", point);
     m_impl->require_finite(where, "plane.normal", normal);
     return *this;
@@ -411,9 +406,7 @@ SceneBuilder& SceneBuilder::plane(Vec3 point, Vec3 normal, const Material& mater
 
 SceneBuilder& SceneBuilder::box(Vec3 min, Vec3 max, const Material& material) {
     const SourceLocation where = m_impl->next();
-    ObjectDescription& object = m_impl->add_object(ObjectType::box, where, material);
-    object.min = given(vec(min), where);
-    object.max = given(vec(max), where);
+    m_impl->add_object(BoxShape{given(vec(min), where), given(vec(max), where)}, where, material);
     m_impl->require_finite(where, "box.min", min);
     m_impl->require_finite(where, "box.max", max);
     return *this;
@@ -421,9 +414,7 @@ SceneBuilder& SceneBuilder::box(Vec3 min, Vec3 max, const Material& material) {
 
 SceneBuilder& SceneBuilder::triangle(Vec3 a, Vec3 b, Vec3 c, const Material& material) {
     const SourceLocation where = m_impl->next();
-    ObjectDescription& object = m_impl->add_object(ObjectType::triangle, where, material);
-    object.vertices_where = where;
-    object.vertices = {vec(a), vec(b), vec(c)};
+    m_impl->add_object(TriangleShape{where, {vec(a), vec(b), vec(c)}}, where, material);
     m_impl->require_finite(where, "triangle.vertices", {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z});
     return *this;
 }

@@ -51,8 +51,9 @@ TEST(CourseXml, ElementsBecomeWhittedKeysWithTheirPlaces) {
     EXPECT_EQ(d.materials[0].ka.value, Color(0.0));
     EXPECT_EQ(d.materials[0].p.value, 50);
     ASSERT_EQ(d.objects.size(), 1u);
-    EXPECT_EQ(d.objects[0].center.value, Vec3(0, 0, 0));  // default centre
-    EXPECT_EQ(d.objects[0].radius.value, 2);
+    const auto& sphere = std::get<SphereShape>(d.objects[0].shape);
+    EXPECT_EQ(sphere.center.value, Vec3(0, 0, 0));  // default centre
+    EXPECT_EQ(sphere.radius.value, 2);
     EXPECT_EQ(d.lights[0].intensity.value, Color(1.0));
     EXPECT_EQ(d.convention.value, Convention::course);
     EXPECT_EQ(d.ambient.value, Color(0.0));
@@ -99,7 +100,7 @@ TEST(CourseXml, GroupTransformsAreReversedAndRotationIsXThenYThenZ) {
     EXPECT_EQ(steps[3].angle, 30);
     EXPECT_EQ(steps[4].kind, TransformStep::Kind::translate);
     // The children inherit nothing but the shader they name.
-    EXPECT_EQ(d.objects[0].children[0].material->name, "s");
+    EXPECT_EQ(std::get<GroupShape>(d.objects[0].shape).objects[0].material->name, "s");
 }
 
 TEST(CourseXml, GlazedTakesTheSubstrateAndTheIndex) {
@@ -251,10 +252,14 @@ TEST(CourseXml, ElementNamesIgnoreCaseAsTheCoursesParserDoes) {
         EXPECT_EQ(d.materials[0].ks.value, canonical.materials[0].ks.value);
         EXPECT_EQ(d.materials[1].fresnel_ior.value, canonical.materials[1].fresnel_ior.value);
         ASSERT_EQ(d.objects.size(), canonical.objects.size());
-        EXPECT_EQ(d.objects[0].max.value, canonical.objects[0].max.value);
-        ASSERT_EQ(d.objects[1].children.size(), 1u);
+        EXPECT_EQ(std::get<BoxShape>(d.objects[0].shape).max.value,
+                  std::get<BoxShape>(canonical.objects[0].shape).max.value);
+        const auto& group = std::get<GroupShape>(d.objects[1].shape);
+        const auto& canonical_group = std::get<GroupShape>(canonical.objects[1].shape);
+        ASSERT_EQ(group.objects.size(), 1u);
         EXPECT_EQ(d.objects[1].transform.size(), canonical.objects[1].transform.size());
-        EXPECT_EQ(d.objects[1].children[0].radius.value, canonical.objects[1].children[0].radius.value);
+        EXPECT_EQ(std::get<SphereShape>(group.objects[0].shape).radius.value,
+                  std::get<SphereShape>(canonical_group.objects[0].shape).radius.value);
         EXPECT_EQ(d.lights[0].position.value, canonical.lights[0].position.value);
     }
     // A name that is no element in any case is still refused, with its place and a suggestion.

@@ -83,39 +83,39 @@ TEST(Nff, EntitiesBecomeWhittedObjectsWithTheirPlaces) {
     EXPECT_EQ(f2.ior.where.column, 27);
 
     ASSERT_EQ(d.objects.size(), 5u);
-    const ObjectDescription& sphere = d.objects[0];
-    EXPECT_EQ(sphere.type, ObjectType::sphere);
+    ASSERT_EQ(d.objects[0].type(), ObjectType::sphere);
+    const auto& sphere = std::get<SphereShape>(d.objects[0].shape);
     EXPECT_EQ(sphere.radius.value, 0.5);  // a negative radius: its inside, and Whitted has two sides
-    EXPECT_EQ(sphere.material->name, "f1");
-    EXPECT_EQ(sphere.where.line, 13);
+    EXPECT_EQ(d.objects[0].material->name, "f1");
+    EXPECT_EQ(d.objects[0].where.line, 13);
 
-    const ObjectDescription& square = d.objects[1];
-    EXPECT_EQ(square.type, ObjectType::mesh);
+    ASSERT_EQ(d.objects[1].type(), ObjectType::mesh);
+    const auto& square = std::get<MeshShape>(d.objects[1].shape);
     EXPECT_EQ(square.vertices.size(), 4u);
     EXPECT_EQ(square.triangles.size(), 2u);
     EXPECT_TRUE(square.normals.empty());
-    EXPECT_EQ(square.material->name, "f1");
+    EXPECT_EQ(d.objects[1].material->name, "f1");
 
-    const ObjectDescription& cylinder = d.objects[2];
-    EXPECT_EQ(cylinder.type, ObjectType::cylinder);
+    ASSERT_EQ(d.objects[2].type(), ObjectType::cylinder);
+    const auto& cylinder = std::get<CylinderShape>(d.objects[2].shape);
     EXPECT_EQ(cylinder.base.value, Vec3(0, 0, 0));
     EXPECT_EQ(cylinder.cap.value, Vec3(0, 0, 1));
     EXPECT_EQ(cylinder.radius.value, 0.2);
     EXPECT_TRUE(cylinder.open.value);  // NFF's cones have no end caps
-    EXPECT_EQ(cylinder.material->name, "f2");
+    EXPECT_EQ(d.objects[2].material->name, "f2");
 
-    const ObjectDescription& cone = d.objects[3];
-    EXPECT_EQ(cone.type, ObjectType::cone);
+    ASSERT_EQ(d.objects[3].type(), ObjectType::cone);
+    const auto& cone = std::get<ConeShape>(d.objects[3].shape);
     EXPECT_EQ(cone.base_radius.value, 0.3);
     EXPECT_EQ(cone.cap_radius.value, 0.1);
     EXPECT_EQ(cone.cap.value, Vec3(1, 0, 1));
     EXPECT_TRUE(cone.open.value);
 
-    const ObjectDescription& patch = d.objects[4];
-    EXPECT_EQ(patch.type, ObjectType::mesh);
+    ASSERT_EQ(d.objects[4].type(), ObjectType::mesh);
+    const auto& patch = std::get<MeshShape>(d.objects[4].shape);
     ASSERT_EQ(patch.normals.size(), 3u);
     EXPECT_EQ(patch.normals[1], Vec3(0, 0.1, 1));
-    EXPECT_EQ(patch.material->name, "f2");
+    EXPECT_EQ(d.objects[4].material->name, "f2");
 }
 
 TEST(Nff, PolygonsOfOneFillShareAMeshAndANewFillStartsAnother) {
@@ -124,10 +124,11 @@ TEST(Nff, PolygonsOfOneFillShareAMeshAndANewFillStartsAnother) {
     const SceneDescription d =
         parse_nff_text(view + "f 1 1 1 1 0 1 0 0\n" + triangle + triangle + "f 1 0 0 1 0 1 0 0\n" + triangle, "m.nff");
     ASSERT_EQ(d.objects.size(), 2u);
-    EXPECT_EQ(d.objects[0].triangles.size(), 2u);
-    EXPECT_EQ(d.objects[0].vertices.size(), 6u);
-    EXPECT_EQ(d.objects[0].triangles[1], (std::array<int64_t, 3>{3, 4, 5}));
-    EXPECT_EQ(d.objects[1].triangles.size(), 1u);
+    const auto& first = std::get<MeshShape>(d.objects[0].shape);
+    EXPECT_EQ(first.triangles.size(), 2u);
+    EXPECT_EQ(first.vertices.size(), 6u);
+    EXPECT_EQ(first.triangles[1], (std::array<int64_t, 3>{3, 4, 5}));
+    EXPECT_EQ(std::get<MeshShape>(d.objects[1].shape).triangles.size(), 1u);
     EXPECT_EQ(d.objects[1].material->name, "f2");
 }
 
@@ -137,7 +138,7 @@ TEST(Nff, AConcavePolygonIsCutIntoTrianglesThatCoverIt) {
     const std::string l_shape = "p 6\n0 0 0\n2 0 0\n2 1 0\n1 1 0\n1 2 0\n0 2 0\n";
     const SceneDescription d =
         parse_nff_text("v from 0 0 5 at 0 0 0 up 0 1 0 angle 30\nf 1 1 1 1 0 1 0 0\n" + l_shape, "l.nff");
-    const ObjectDescription& mesh = d.objects.at(0);
+    const auto& mesh = std::get<MeshShape>(d.objects.at(0).shape);
     ASSERT_EQ(mesh.triangles.size(), 4u);
     double area = 0;
     for (const auto& t : mesh.triangles) {

@@ -82,7 +82,7 @@ TEST(Parse, JsonSceneAndGreyShorthand) {
     ASSERT_TRUE(d.objects[0].material && d.objects[0].material->inline_);
     EXPECT_EQ(d.objects[0].material->inline_->kd.value, Color(0.5));
     EXPECT_EQ(d.objects[0].material->inline_->km.value, (Color{0.1, 0.2, 0.3}));
-    EXPECT_EQ(d.objects[0].radius.value, 2.0);
+    EXPECT_EQ(std::get<SphereShape>(d.objects[0].shape).radius.value, 2.0);
 }
 
 TEST(ParseErrors, YamlSyntaxErrorAtTheStrayBracket) {

@@ -243,7 +243,7 @@ TEST(PovWriter, NumbersRoundTripExactly) {
     EXPECT_EQ(light, (std::vector<double>{0.30000000000000004, -1.0000000000000002e-7, 123456.78901234567}));
     const auto sphere = numbers_after(sdl, "sphere {", 4);
     EXPECT_EQ(sphere, (std::vector<double>{0.1, -2.718281828459045, 3.0e+21, 0.7071067811865476}));
-    EXPECT_EQ(sphere[3], d.objects[0].radius.value);
+    EXPECT_EQ(sphere[3], std::get<SphereShape>(d.objects[0].shape).radius.value);
     const auto pigment = numbers_after(sdl, "pigment { rgb", 3);
     EXPECT_EQ(pigment, (std::vector<double>{0.123456789012345678, 0.1, 1e-300}));
     EXPECT_EQ(numbers_after(sdl, "angle", 1)[0], 33.3);

@@ -550,7 +550,7 @@ private:
             }
         if (!material && inherited && *inherited) material = **inherited;
         if (*type == "Group") {
-            object.type = ObjectType::group;
+            GroupShape& group = object.shape.emplace<GroupShape>();
             if (depth + 1 > limits::max_nesting)
                 throw InputError(e.where, "<surface type=\"Group\">: groups nested deeper than " +
                                               std::to_string(limits::max_nesting) + " levels");
@@ -562,7 +562,7 @@ private:
                 const Element& c = *child;
                 if (c.name == "shader") continue;
                 if (c.name == "surface") {
-                    object.children.push_back(read_surface(c, &material, depth + 1));
+                    group.objects.push_back(read_surface(c, &material, depth + 1));
                     continue;
                 }
                 if (c.name != "translate" && c.name != "rotate" && c.name != "scale")
@@ -588,33 +588,33 @@ private:
         object.material = material;
         if (!object.material) throw InputError(e.where, "<surface>: missing <shader>");
         if (*type == "Sphere") {
-            object.type = ObjectType::sphere;
-            object.center = Located<Vec3>{Vec3{0, 0, 0}};
-            object.radius = Located<double>{1.0};
-            object.center.where = object.radius.where = e.where;
-            object.center.given = object.radius.given = true;
+            SphereShape& sphere = object.shape.emplace<SphereShape>();
+            sphere.center = Located<Vec3>{Vec3{0, 0, 0}};
+            sphere.radius = Located<double>{1.0};
+            sphere.center.where = sphere.radius.where = e.where;
+            sphere.center.given = sphere.radius.given = true;
             for (const auto& child : e.children) {
                 const Element& c = *child;
                 if (c.name == "shader") continue;
                 check_leaf(c);
                 if (c.name == "center")
-                    object.center = vec3(c);
+                    sphere.center = vec3(c);
                 else if (c.name == "radius")
-                    object.radius = number(c);
+                    sphere.radius = number(c);
                 else
                     unknown_element(c, e, {"shader", "center", "radius"});
             }
         } else if (*type == "Box") {
-            object.type = ObjectType::box;
+            BoxShape& box = object.shape.emplace<BoxShape>();
             bool have_min = false, have_max = false;
             for (const auto& child : e.children) {
                 const Element& c = *child;
                 if (c.name == "shader") continue;
                 check_leaf(c);
                 if (c.name == "minPt")
-                    object.min = vec3(c), have_min = true;
+                    box.min = vec3(c), have_min = true;
                 else if (c.name == "maxPt")
-                    object.max = vec3(c), have_max = true;
+                    box.max = vec3(c), have_max = true;
                 else
                     unknown_element(c, e, {"shader", "minPt", "maxPt"});
             }
@@ -622,7 +622,7 @@ private:
                 throw InputError(
                     e.where, std::string("<surface type=\"Box\">: missing <") + (have_min ? "maxPt" : "minPt") + ">");
         } else if (*type == "Mesh") {
-            object.type = ObjectType::mesh;
+            MeshShape& mesh = object.shape.emplace<MeshShape>();
             for (const auto& child : e.children) {
                 const Element& c = *child;
                 if (c.name == "shader") continue;
@@ -632,18 +632,16 @@ private:
                 if (words.size() != 1)
                     throw InputError(words.empty() ? c.where : words.front().second,
                                      "<data>: expected one .msh file name");
-                object.file = Located<std::string>{words[0].first};
-                object.file.where = words[0].second;
-                object.file.given = true;
+                mesh.file = Located<std::string>{words[0].first};
+                mesh.file.where = words[0].second;
+                mesh.file.given = true;
                 const std::filesystem::path file(words[0].first);
-                object.file_path =
+                mesh.file_path =
                     file.is_absolute() ? file.string() : (std::filesystem::path(m_directory) / file).string();
             }
-            if (!object.file.given)
-                throw InputError(e.where, "<surface type=\"Mesh\">: missing <data> (the .msh file)");
-            if (std::filesystem::path(object.file.value).extension() != ".msh")
-                throw InputError(object.file.where,
-                                 "<data>: expected a .msh mesh file, got '" + object.file.value + "'");
+            if (!mesh.file.given) throw InputError(e.where, "<surface type=\"Mesh\">: missing <data> (the .msh file)");
+            if (std::filesystem::path(mesh.file.value).extension() != ".msh")
+                throw InputError(mesh.file.where, "<data>: expected a .msh mesh file, got '" + mesh.file.value + "'");
         } else {
             throw InputError(e.where, "<surface>: unknown type '" + *type + "'; expected Sphere, Box, Mesh or Group");
         }

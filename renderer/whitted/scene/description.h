@@ -16,6 +16,8 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <type_traits>
+#include <variant>
 #include <vector>
 
 namespace whitted {
@@ -144,49 +146,118 @@ struct TransformStep {
     std::array<double, 16> matrix{};  ///< matrix: row-major 4x4
 };
 
-/// `instance`: a placement of a prototype (SceneDescription::prototypes), declared once and
-/// shared by every placement (docs/scene-format.md §3.8).
+/// The kinds of object in the scene format (docs/scene-format.md §3), in the order of the
+/// alternatives of ObjectDescription::Shape; the built Scene keeps it for each object (scene.h).
 enum class ObjectType { sphere, plane, box, triangle, mesh, group, instance, cylinder, cone };
 
-struct ObjectDescription {
-    SourceLocation where;
-    ObjectType type = ObjectType::sphere;
-    std::vector<TransformStep> transform;  ///< applied in list order
-    std::optional<MaterialReference> material;
+struct ObjectDescription;
 
-    // sphere
+// One struct per object kind, with the keys that kind takes in the scene format (§3), so that no
+// kind's value is visible on another. ObjectDescription holds the keys every kind shares.
+
+struct SphereShape {
     Located<Vec3> center;
     Located<double> radius;
-    // plane
+};
+
+struct PlaneShape {
     Located<Vec3> point;
     Located<Vec3> normal;
-    // box
+};
+
+struct BoxShape {
     Located<Vec3> min;
     Located<Vec3> max;
-    // triangle (3 vertices) and inline mesh
+};
+
+struct TriangleShape {
+    SourceLocation vertices_where;
+    std::vector<Vec3> vertices;  ///< exactly 3
+};
+
+/// Inline (`vertices`, `triangles`, optional `normals`) or from a `file` (OBJ or a course .msh).
+struct MeshShape {
     SourceLocation vertices_where;
     std::vector<Vec3> vertices;
-    // inline mesh
     SourceLocation triangles_where;
     std::vector<std::array<int64_t, 3>> triangles;
     std::vector<SourceLocation> triangle_where;  ///< one per triangle, for index errors
     SourceLocation normals_where;
     std::vector<Vec3> normals;
-    // mesh from a file
-    Located<std::string> file;  ///< as written in the scene
+    Located<std::string> file;  ///< as written in the scene; `given` for a mesh from a file
     std::string file_path;      ///< resolved against the scene file's directory
-    // cylinder (with `radius`) and cone: the centres of the two ends, each end's radius, and
-    // whether the ends are left open (no caps)
+};
+
+/// `group`: its `objects` share its transform (and, in a course scene, its material).
+struct GroupShape {
+    std::vector<ObjectDescription> objects;
+};
+
+/// `instance`: a placement of a prototype (SceneDescription::prototypes), declared once and
+/// shared by every placement (docs/scene-format.md §3.8).
+struct InstanceShape {
+    Located<std::string> prototype;  ///< the name of an entry in `prototypes`
+};
+
+/// The centres of the two ends, one radius, and whether the ends are left open (no caps).
+struct CylinderShape {
     Located<Vec3> base;
     Located<Vec3> cap;
+    Located<double> radius;
+    Located<bool> open{false};
+};
+
+/// The centres of the two ends, each end's radius, and whether the ends are left open.
+struct ConeShape {
+    Located<Vec3> base;
     Located<double> base_radius;
+    Located<Vec3> cap;
     Located<double> cap_radius;
     Located<bool> open{false};
-    // group
-    std::vector<ObjectDescription> children;
-    // instance: the name of an entry in `prototypes`
-    Located<std::string> prototype;
 };
+
+/// An overload set of lambdas for std::visit: with no catch-all among them, a kind left out is a
+/// compile error rather than a silent default.
+template <class... F>
+struct Overloaded : F... {
+    using F::operator()...;
+};
+template <class... F>
+Overloaded(F...) -> Overloaded<F...>;
+
+struct ObjectDescription {
+    /// One alternative per ObjectType, in its order (type() relies on it).
+    using Shape = std::variant<SphereShape, PlaneShape, BoxShape, TriangleShape, MeshShape, GroupShape, InstanceShape,
+                               CylinderShape, ConeShape>;
+
+    SourceLocation where;
+    std::vector<TransformStep> transform;  ///< applied in list order
+    std::optional<MaterialReference> material;
+    Shape shape;
+
+    ObjectType type() const { return static_cast<ObjectType>(shape.index()); }
+};
+
+template <ObjectType kind, class S>
+inline constexpr bool shape_of_kind =
+    std::is_same_v<std::variant_alternative_t<size_t(kind), ObjectDescription::Shape>, S>;
+static_assert(shape_of_kind<ObjectType::sphere, SphereShape> && shape_of_kind<ObjectType::plane, PlaneShape> &&
+              shape_of_kind<ObjectType::box, BoxShape> && shape_of_kind<ObjectType::triangle, TriangleShape> &&
+              shape_of_kind<ObjectType::mesh, MeshShape> && shape_of_kind<ObjectType::group, GroupShape> &&
+              shape_of_kind<ObjectType::instance, InstanceShape> &&
+              shape_of_kind<ObjectType::cylinder, CylinderShape> && shape_of_kind<ObjectType::cone, ConeShape>);
+static_assert(std::variant_size_v<ObjectDescription::Shape> == size_t(ObjectType::cone) + 1);
+
+/// Calls `f` on each object of `list` in file order, and on the members of each group right after
+/// the group itself (depth first): for what every kind has alike (material, transform); what a
+/// kind alone has is reached with std::visit or std::get_if on `shape`.
+template <class List, class F>
+void for_each_object(List&& list, F&& f) {
+    for (auto& object : list) {
+        f(object);
+        if (auto* group = std::get_if<GroupShape>(&object.shape)) for_each_object(group->objects, f);
+    }
+}
 
 /// `prototypes:` entry: a mesh, triangle or group of them, declared once in a space of its own
 /// and placed by `instance` objects, each with its own transform and optionally its own material.

@@ -303,41 +303,38 @@ private:
     /// `s x y z r`: a negative radius means "only the inside is visible", and every surface
     /// has two sides in Whitted.
     void read_sphere(const Token& code) {
-        ObjectDescription sphere;
-        sphere.where = where(code);
-        sphere.type = ObjectType::sphere;
-        sphere.material = material_for(code);
+        ObjectDescription object;
+        object.where = where(code);
+        object.material = material_for(code);
+        SphereShape& sphere = object.shape.emplace<SphereShape>();
         sphere.center = vector("sphere centre");
         sphere.radius = number("sphere radius");
         if (sphere.radius.value < 0) sphere.radius.value = -sphere.radius.value;
-        emit(std::move(sphere));
+        emit(std::move(object));
     }
 
     /// `c`, base point and radius, apex point and radius: an open cylinder (equal radii) or
     /// an open cone. Both radii negative: only the inside is visible, which two-sided surfaces
     /// show anyway.
     void read_cone(const Token& code) {
-        ObjectDescription cone;
-        cone.where = where(code);
-        cone.material = material_for(code);
-        cone.base = vector("cone base");
+        ObjectDescription object;
+        object.where = where(code);
+        object.material = material_for(code);
+        const Located<Vec3> base = vector("cone base");
         Located<double> base_radius = number("cone base radius");
-        cone.cap = vector("cone apex");
+        const Located<Vec3> apex = vector("cone apex");
         Located<double> apex_radius = number("cone apex radius");
         if (base_radius.value < 0 && apex_radius.value <= 0) {
             base_radius.value = -base_radius.value;
             apex_radius.value = -apex_radius.value;
         }
-        set(cone.open, true, cone.where);
-        if (base_radius.value == apex_radius.value) {
-            cone.type = ObjectType::cylinder;
-            cone.radius = base_radius;
-        } else {
-            cone.type = ObjectType::cone;
-            cone.base_radius = base_radius;
-            cone.cap_radius = apex_radius;
-        }
-        emit(std::move(cone));
+        Located<bool> open;
+        set(open, true, object.where);
+        if (base_radius.value == apex_radius.value)
+            object.shape = CylinderShape{base, apex, base_radius, open};
+        else
+            object.shape = ConeShape{base, base_radius, apex, apex_radius, open};
+        emit(std::move(object));
     }
 
     /// `p n` and n corners, or `pp n` and n corners each with its normal. Polygons may be
@@ -367,12 +364,12 @@ private:
         if (!slot) {
             slot.emplace();
             slot->where = where(code);
-            slot->type = ObjectType::mesh;
             slot->material = material_for(code);
-            slot->vertices_where = slot->triangles_where = where(code);
-            if (patch) slot->normals_where = where(code);
+            MeshShape& mesh = slot->shape.emplace<MeshShape>();
+            mesh.vertices_where = mesh.triangles_where = where(code);
+            if (patch) mesh.normals_where = where(code);
         }
-        ObjectDescription& mesh = *slot;
+        MeshShape& mesh = std::get<MeshShape>(slot->shape);
         const auto first = int64_t(mesh.vertices.size());
         if (first + int64_t(n) > int64_t(UINT32_MAX))
             throw InputError(count.where, "more than 2^32 corners in the polygons of one fill");

@@ -455,142 +455,131 @@ ObjectDescription parse_object(ParseContext& ctx, const Node& node, const std::s
                            ": missing required key 'type' (sphere, plane, box, cylinder, cone, triangle, mesh, group "
                            "or instance)");
     ObjectDescription object;
-    static const std::vector<std::pair<std::string, ObjectType>> object_types = {
-        {"sphere", ObjectType::sphere},     {"plane", ObjectType::plane},       {"box", ObjectType::box},
-        {"triangle", ObjectType::triangle}, {"mesh", ObjectType::mesh},         {"group", ObjectType::group},
-        {"instance", ObjectType::instance}, {"cylinder", ObjectType::cylinder}, {"cone", ObjectType::cone}};
-    object.type = parse_choice<ObjectType>(ctx, type_node, what + ".type", object_types);
-    // The keys each type takes: type, transform, material (not for groups), then its own.
+    static const std::vector<std::pair<std::string, ObjectDescription::Shape>> object_kinds = {
+        {"sphere", SphereShape{}},     {"plane", PlaneShape{}},       {"box", BoxShape{}},
+        {"triangle", TriangleShape{}}, {"mesh", MeshShape{}},         {"group", GroupShape{}},
+        {"instance", InstanceShape{}}, {"cylinder", CylinderShape{}}, {"cone", ConeShape{}}};
+    object.shape = parse_choice<ObjectDescription::Shape>(ctx, type_node, what + ".type", object_kinds);
+    // The keys each kind takes: type, transform, material (not for groups), then its own.
     std::array<std::string_view, MapReader::max_keys> keys{"type", "transform"};
     size_t key_count = 2;
     const auto allow = [&](std::initializer_list<std::string_view> more) {
         for (const std::string_view key : more) keys[key_count++] = key;
     };
-    if (object.type != ObjectType::group) allow({"material"});
-    switch (object.type) {
-        case ObjectType::sphere:
-            allow({"center", "radius"});
-            break;
-        case ObjectType::plane:
-            allow({"point", "normal"});
-            break;
-        case ObjectType::box:
-            allow({"min", "max"});
-            break;
-        case ObjectType::cylinder:
-            allow({"base", "cap", "radius", "open"});
-            break;
-        case ObjectType::cone:
-            allow({"base", "base_radius", "cap", "cap_radius", "open"});
-            break;
-        case ObjectType::triangle:
-            allow({"vertices"});
-            break;
-        case ObjectType::mesh:
-            allow({"file", "vertices", "triangles", "normals"});
-            break;
-        case ObjectType::group:
-            allow({"objects"});
-            break;
-        case ObjectType::instance:
-            allow({"prototype"});
-            break;
-    }
-    MapReader map(ctx, node, what + " (" + to_string(object.type) + ")", keys.data(), key_count);
+    if (object.type() != ObjectType::group) allow({"material"});
+    std::visit(
+        Overloaded{[&](const SphereShape&) {
+                       allow({"center", "radius"});
+                   },
+                   [&](const PlaneShape&) {
+                       allow({"point", "normal"});
+                   },
+                   [&](const BoxShape&) {
+                       allow({"min", "max"});
+                   },
+                   [&](const CylinderShape&) {
+                       allow({"base", "cap", "radius", "open"});
+                   },
+                   [&](const ConeShape&) {
+                       allow({"base", "base_radius", "cap", "cap_radius", "open"});
+                   },
+                   [&](const TriangleShape&) { allow({"vertices"}); },
+                   [&](const MeshShape&) {
+                       allow({"file", "vertices", "triangles", "normals"});
+                   },
+                   [&](const GroupShape&) { allow({"objects"}); }, [&](const InstanceShape&) { allow({"prototype"}); }},
+        object.shape);
+    MapReader map(ctx, node, what + " (" + to_string(object.type()) + ")", keys.data(), key_count);
     const std::string& label = map.name();
     object.where = map.where();
     if (map.has("transform")) object.transform = parse_transform(ctx, map.get("transform"), label + ".transform");
     if (map.has("material")) object.material = parse_material_reference(ctx, map.get("material"), label + ".material");
 
-    switch (object.type) {
-        case ObjectType::sphere:
-            map.vec3(object.center, "center", true);
-            map.number(object.radius, "radius", true);
-            break;
-        case ObjectType::plane:
-            map.vec3(object.point, "point", true);
-            map.vec3(object.normal, "normal", true);
-            break;
-        case ObjectType::box:
-            map.vec3(object.min, "min", true);
-            map.vec3(object.max, "max", true);
-            break;
-        case ObjectType::cylinder:
-            map.vec3(object.base, "base", true);
-            map.vec3(object.cap, "cap", true);
-            map.number(object.radius, "radius", true);
-            map.read(object.open, "open", parse_boolean);
-            break;
-        case ObjectType::cone:
-            map.vec3(object.base, "base", true);
-            map.number(object.base_radius, "base_radius", true);
-            map.vec3(object.cap, "cap", true);
-            map.number(object.cap_radius, "cap_radius", true);
-            map.read(object.open, "open", parse_boolean);
-            break;
-        case ObjectType::triangle: {
-            const Node vertices = map.require("vertices");
-            object.vertices_where = ctx.at(vertices);
-            object.vertices = parse_vec3_list(ctx, vertices, label + ".vertices");
-            if (object.vertices.size() != 3)
-                ctx.fail(vertices, label + ".vertices: a triangle needs exactly 3 vertices, got " +
-                                       std::to_string(object.vertices.size()));
-            break;
-        }
-        case ObjectType::mesh: {
-            if (map.has("file")) {
-                for (const char* inline_key : {"vertices", "triangles", "normals"})
-                    if (map.has(inline_key))
-                        ctx.fail(map.get(inline_key),
-                                 label + ": give either 'file' or inline 'vertices'/'triangles', not both");
-                map.read(object.file, "file", parse_string);
-                if (object.file.value.empty()) ctx.fail(map.get("file"), label + ".file: empty path");
-                const std::filesystem::path file(object.file.value);
-                object.file_path =
-                    file.is_absolute() ? file.string() : (std::filesystem::path(ctx.directory) / file).string();
-                break;
-            }
-            if (!map.has("vertices") && !map.has("triangles"))
-                ctx.fail(node, label + ": a mesh needs 'file', or inline 'vertices' and 'triangles'");
-            const Node vertices = map.require("vertices");
-            object.vertices_where = ctx.at(vertices);
-            object.vertices = parse_vec3_list(ctx, vertices, label + ".vertices");
-            const Node triangles = map.require("triangles");
-            object.triangles_where = ctx.at(triangles);
-            if (!triangles.IsSequence())
-                ctx.fail(triangles, label + ".triangles: expected a list of [i, j, k], got " + describe(triangles));
-            for (size_t i = 0; i < triangles.size(); ++i) {
-                const Node triangle = triangles[i];
-                const std::string item = label + ".triangles[" + std::to_string(i) + "]";
-                if (!triangle.IsSequence() || triangle.size() != 3)
-                    ctx.fail(triangle, item + ": expected 3 vertex indices [i, j, k], got " +
-                                           (triangle.IsSequence() ? "a list of " + std::to_string(triangle.size())
-                                                                  : describe(triangle)));
-                object.triangles.push_back({parse_integer(ctx, triangle[0], item),
-                                            parse_integer(ctx, triangle[1], item),
-                                            parse_integer(ctx, triangle[2], item)});
-                object.triangle_where.push_back(ctx.at(triangle));
-            }
-            if (map.has("normals")) {
-                const Node normals = map.get("normals");
-                object.normals_where = ctx.at(normals);
-                object.normals = parse_vec3_list(ctx, normals, label + ".normals");
-            }
-            break;
-        }
-        case ObjectType::group: {
-            if (depth + 1 > limits::max_nesting)
-                ctx.fail(node,
-                         label + ": groups nested deeper than " + std::to_string(limits::max_nesting) + " levels");
-            const Node children = map.require("objects");
-            object.children = parse_objects(ctx, children, label + ".objects", depth + 1);
-            break;
-        }
-        case ObjectType::instance:
+    std::visit(
+        Overloaded{
+            [&](SphereShape& sphere) {
+                map.vec3(sphere.center, "center", true);
+                map.number(sphere.radius, "radius", true);
+            },
+            [&](PlaneShape& plane) {
+                map.vec3(plane.point, "point", true);
+                map.vec3(plane.normal, "normal", true);
+            },
+            [&](BoxShape& box) {
+                map.vec3(box.min, "min", true);
+                map.vec3(box.max, "max", true);
+            },
+            [&](CylinderShape& cylinder) {
+                map.vec3(cylinder.base, "base", true);
+                map.vec3(cylinder.cap, "cap", true);
+                map.number(cylinder.radius, "radius", true);
+                map.read(cylinder.open, "open", parse_boolean);
+            },
+            [&](ConeShape& cone) {
+                map.vec3(cone.base, "base", true);
+                map.number(cone.base_radius, "base_radius", true);
+                map.vec3(cone.cap, "cap", true);
+                map.number(cone.cap_radius, "cap_radius", true);
+                map.read(cone.open, "open", parse_boolean);
+            },
+            [&](TriangleShape& triangle) {
+                const Node vertices = map.require("vertices");
+                triangle.vertices_where = ctx.at(vertices);
+                triangle.vertices = parse_vec3_list(ctx, vertices, label + ".vertices");
+                if (triangle.vertices.size() != 3)
+                    ctx.fail(vertices, label + ".vertices: a triangle needs exactly 3 vertices, got " +
+                                           std::to_string(triangle.vertices.size()));
+            },
+            [&](MeshShape& mesh) {
+                if (map.has("file")) {
+                    for (const char* inline_key : {"vertices", "triangles", "normals"})
+                        if (map.has(inline_key))
+                            ctx.fail(map.get(inline_key),
+                                     label + ": give either 'file' or inline 'vertices'/'triangles', not both");
+                    map.read(mesh.file, "file", parse_string);
+                    if (mesh.file.value.empty()) ctx.fail(map.get("file"), label + ".file: empty path");
+                    const std::filesystem::path file(mesh.file.value);
+                    mesh.file_path =
+                        file.is_absolute() ? file.string() : (std::filesystem::path(ctx.directory) / file).string();
+                    return;
+                }
+                if (!map.has("vertices") && !map.has("triangles"))
+                    ctx.fail(node, label + ": a mesh needs 'file', or inline 'vertices' and 'triangles'");
+                const Node vertices = map.require("vertices");
+                mesh.vertices_where = ctx.at(vertices);
+                mesh.vertices = parse_vec3_list(ctx, vertices, label + ".vertices");
+                const Node triangles = map.require("triangles");
+                mesh.triangles_where = ctx.at(triangles);
+                if (!triangles.IsSequence())
+                    ctx.fail(triangles, label + ".triangles: expected a list of [i, j, k], got " + describe(triangles));
+                for (size_t i = 0; i < triangles.size(); ++i) {
+                    const Node triangle = triangles[i];
+                    const std::string item = label + ".triangles[" + std::to_string(i) + "]";
+                    if (!triangle.IsSequence() || triangle.size() != 3)
+                        ctx.fail(triangle, item + ": expected 3 vertex indices [i, j, k], got " +
+                                               (triangle.IsSequence() ? "a list of " + std::to_string(triangle.size())
+                                                                      : describe(triangle)));
+                    mesh.triangles.push_back({parse_integer(ctx, triangle[0], item),
+                                              parse_integer(ctx, triangle[1], item),
+                                              parse_integer(ctx, triangle[2], item)});
+                    mesh.triangle_where.push_back(ctx.at(triangle));
+                }
+                if (map.has("normals")) {
+                    const Node normals = map.get("normals");
+                    mesh.normals_where = ctx.at(normals);
+                    mesh.normals = parse_vec3_list(ctx, normals, label + ".normals");
+                }
+            },
+            [&](GroupShape& group) {
+                if (depth + 1 > limits::max_nesting)
+                    ctx.fail(node,
+                             label + ": groups nested deeper than " + std::to_string(limits::max_nesting) + " levels");
+                const Node children = map.require("objects");
+                group.objects = parse_objects(ctx, children, label + ".objects", depth + 1);
+            },
             // Resolved in validation, where every prototype is known (they may come after `objects`).
-            map.read(object.prototype, "prototype", parse_string, true);
-            break;
-    }
+            [&](InstanceShape& instance) { map.read(instance.prototype, "prototype", parse_string, true); }},
+        object.shape);
     return object;
 }
 

@@ -227,7 +227,7 @@ private:
 
     uint32_t resolve_material(const ObjectDescription& object) {
         ++m_step;
-        const char* kind = to_string(object.type);
+        const char* kind = to_string(object.type());
         // In a prototype the material may be left to each instance.
         if (!object.material && m_prototype) return Instance::no_material;
         if (!object.material) fail(object.where, std::string(kind) + ": missing required key 'material'");
@@ -261,87 +261,88 @@ private:
         if (!(std::fabs(determinant) > 1e-300))
             fail(object.transform.empty() ? object.where : object.transform.front().where,
                  "the transform is singular (it flattens the object)");
-        if (m_prototype && object.type != ObjectType::mesh && object.type != ObjectType::triangle &&
-            object.type != ObjectType::group)
+        const ObjectType type = object.type();
+        if (m_prototype && type != ObjectType::mesh && type != ObjectType::triangle && type != ObjectType::group)
             fail(object.where,
                  std::string("prototypes.") + printable(m_prototype->name) +
-                     (object.type == ObjectType::instance ? ": an " : ": a ") + to_string(object.type) +
+                     (type == ObjectType::instance ? ": an " : ": a ") + to_string(type) +
                      " cannot be in a prototype; prototypes hold meshes and triangles (in groups or not)");
-        switch (object.type) {
-            case ObjectType::instance:
-                add_instance(object, to_world);
-                break;
-            case ObjectType::sphere: {
-                if (!(object.radius.value > 0)) fail(object.radius.where, "sphere.radius must be > 0");
-                m_scene.spheres.push_back({shared(to_world), object.center.value, object.radius.value,
-                                           resolve_material(object), add_id(object)});
-                break;
-            }
-            case ObjectType::plane: {
-                require_non_zero(object.normal, "plane.normal");
-                const Vec3 normal = unit_direction(to_world.apply_normal(object.normal.value));
-                m_scene.planes.push_back(
-                    {to_world.apply_point(object.point.value), normal, resolve_material(object), add_id(object)});
-                break;
-            }
-            case ObjectType::box: {
-                const Vec3 lo = object.min.value, hi = object.max.value;
-                if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z))
-                    fail(object.max.where, "box: min must be less than max on every axis (min " + format(lo) +
-                                               ", max " + format(hi) + ")");
-                m_scene.boxes.push_back({shared(to_world), lo, hi, resolve_material(object), add_id(object)});
-                break;
-            }
-            case ObjectType::cylinder:
-            case ObjectType::cone:
-                add_cone(object, to_world);
-                break;
-            case ObjectType::triangle: {
-                TriangleMesh mesh;
-                mesh.material = resolve_material(object);
-                set_positions(
-                    mesh, 3, [&](size_t i) { return to_world.apply_point(object.vertices[i]); }, object.vertices_where);
-                mesh.indices = {0, 1, 2};
-                mesh.object = add_id(object);
-                add_mesh(std::move(mesh));
-                break;
-            }
-            case ObjectType::mesh:
-                if (object.file.given)
-                    add_mesh_file(object, to_world);
-                else
-                    add_inline_mesh(object, to_world);
-                break;
-            case ObjectType::group:
-                for (const auto& child : object.children) add_object(child, to_world);
-                break;
-        }
+        std::visit(
+            Overloaded{
+                [&](const SphereShape& sphere) {
+                    if (!(sphere.radius.value > 0)) fail(sphere.radius.where, "sphere.radius must be > 0");
+                    m_scene.spheres.push_back({shared(to_world), sphere.center.value, sphere.radius.value,
+                                               resolve_material(object), add_id(object)});
+                },
+                [&](const PlaneShape& plane) {
+                    require_non_zero(plane.normal, "plane.normal");
+                    const Vec3 normal = unit_direction(to_world.apply_normal(plane.normal.value));
+                    m_scene.planes.push_back(
+                        {to_world.apply_point(plane.point.value), normal, resolve_material(object), add_id(object)});
+                },
+                [&](const BoxShape& box) {
+                    const Vec3 lo = box.min.value, hi = box.max.value;
+                    if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z))
+                        fail(box.max.where, "box: min must be less than max on every axis (min " + format(lo) +
+                                                ", max " + format(hi) + ")");
+                    m_scene.boxes.push_back({shared(to_world), lo, hi, resolve_material(object), add_id(object)});
+                },
+                // A cylinder is a cone with equal radii (docs/scene-format.md §3.9).
+                [&](const CylinderShape& cylinder) {
+                    add_cone(object, true, cylinder.base, cylinder.radius, cylinder.cap, cylinder.radius, cylinder.open,
+                             to_world);
+                },
+                [&](const ConeShape& cone) {
+                    add_cone(object, false, cone.base, cone.base_radius, cone.cap, cone.cap_radius, cone.open,
+                             to_world);
+                },
+                [&](const TriangleShape& triangle) {
+                    TriangleMesh mesh;
+                    mesh.material = resolve_material(object);
+                    set_positions(
+                        mesh, 3, [&](size_t i) { return to_world.apply_point(triangle.vertices[i]); },
+                        triangle.vertices_where);
+                    mesh.indices = {0, 1, 2};
+                    mesh.object = add_id(object);
+                    add_mesh(std::move(mesh));
+                },
+                [&](const MeshShape& mesh) {
+                    if (mesh.file.given)
+                        add_mesh_file(object, mesh, to_world);
+                    else
+                        add_inline_mesh(object, mesh, to_world);
+                },
+                [&](const GroupShape& group) {
+                    for (const auto& child : group.objects) add_object(child, to_world);
+                },
+                [&](const InstanceShape& instance) { add_instance(object, instance, to_world); }},
+            object.shape);
     }
 
-    /// A cylinder is a cone with equal radii (docs/scene-format.md §3.9).
-    void add_cone(const ObjectDescription& object, const Transform& to_world) {
-        const bool cylinder = object.type == ObjectType::cylinder;
+    /// A cylinder has one radius for both ends (`radius`: base_radius and cap_radius are the same
+    /// value), a cone one for each.
+    void add_cone(const ObjectDescription& object, bool cylinder, const Located<Vec3>& base,
+                  const Located<double>& base_radius, const Located<Vec3>& cap, const Located<double>& cap_radius,
+                  const Located<bool>& open, const Transform& to_world) {
         const std::string kind = cylinder ? "cylinder" : "cone";
-        const Located<double>& base_radius = cylinder ? object.radius : object.base_radius;
-        const Located<double>& cap_radius = cylinder ? object.radius : object.cap_radius;
         if (!(base_radius.value >= 0))
             fail(base_radius.where, kind + (cylinder ? ".radius must be > 0" : ".base_radius must be >= 0"));
         if (!(cap_radius.value >= 0)) fail(cap_radius.where, kind + ".cap_radius must be >= 0");
         if (!(base_radius.value > 0 || cap_radius.value > 0))
-            fail(cylinder ? object.radius.where : object.cap_radius.where,
+            fail(cap_radius.where,
                  kind + (cylinder ? ".radius must be > 0" : ": base_radius and cap_radius must not both be 0"));
-        const Vec3 axis = object.cap.value - object.base.value;
+        const Vec3 axis = cap.value - base.value;
         const double height = length(axis);
         if (!(height > 0 && std::isfinite(height)))
-            fail(object.cap.where, kind + ": base and cap must be different points (at a finite distance)");
+            fail(cap.where, kind + ": base and cap must be different points (at a finite distance)");
         Cone cone;
         cone.object_to_world = shared(to_world);
-        cone.base = object.base.value;
+        cone.base = base.value;
         cone.axis = axis / height;
         cone.height = height;
         cone.base_radius = base_radius.value;
         cone.cap_radius = cap_radius.value;
-        cone.open = object.open.value;
+        cone.open = open.value;
         cone.material = resolve_material(object);
         cone.object = add_id(object);
         m_scene.cones.push_back(std::move(cone));
@@ -349,9 +350,9 @@ private:
 
     /// The instance's material now (a provisional number, as every object's), its prototype in
     /// finish(): the prototypes may come after the objects in the file.
-    void add_instance(const ObjectDescription& object, const Transform& to_world) {
+    void add_instance(const ObjectDescription& object, const InstanceShape& instance, const Transform& to_world) {
         PendingInstance pending;
-        pending.prototype = object.prototype;
+        pending.prototype = instance.prototype;
         pending.where = object.where;
         pending.to_world = to_world;
         pending.step = m_step;
@@ -404,49 +405,47 @@ private:
         return out;
     }
 
-    void add_inline_mesh(const ObjectDescription& object, const Transform& to_world) {
-        const size_t n = object.vertices.size();
-        if (n < 3) fail(object.vertices_where, "mesh.vertices: a mesh needs at least 3 vertices");
-        if (object.triangles.empty())
-            fail(object.triangles_where, "mesh.triangles: a mesh needs at least one triangle");
-        if (!object.normals.empty() && object.normals.size() != n)
-            fail(object.normals_where, "mesh.normals: " + std::to_string(object.normals.size()) + " normals for " +
-                                           std::to_string(n) + " vertices; give one per vertex");
+    void add_inline_mesh(const ObjectDescription& object, const MeshShape& shape, const Transform& to_world) {
+        const size_t n = shape.vertices.size();
+        if (n < 3) fail(shape.vertices_where, "mesh.vertices: a mesh needs at least 3 vertices");
+        if (shape.triangles.empty()) fail(shape.triangles_where, "mesh.triangles: a mesh needs at least one triangle");
+        if (!shape.normals.empty() && shape.normals.size() != n)
+            fail(shape.normals_where, "mesh.normals: " + std::to_string(shape.normals.size()) + " normals for " +
+                                          std::to_string(n) + " vertices; give one per vertex");
         TriangleMesh mesh;
         mesh.material = resolve_material(object);
         set_positions(
-            mesh, n, [&](size_t i) { return to_world.apply_point(object.vertices[i]); }, object.vertices_where);
-        for (size_t t = 0; t < object.triangles.size(); ++t)
-            for (const int64_t index : object.triangles[t]) {
+            mesh, n, [&](size_t i) { return to_world.apply_point(shape.vertices[i]); }, shape.vertices_where);
+        for (size_t t = 0; t < shape.triangles.size(); ++t)
+            for (const int64_t index : shape.triangles[t]) {
                 if (index < 0 || index >= static_cast<int64_t>(n))
-                    fail(object.triangle_where[t], "mesh.triangles[" + std::to_string(t) + "]: vertex index " +
-                                                       std::to_string(index) + " is out of range (0.." +
-                                                       std::to_string(n - 1) + ")");
+                    fail(shape.triangle_where[t], "mesh.triangles[" + std::to_string(t) + "]: vertex index " +
+                                                      std::to_string(index) + " is out of range (0.." +
+                                                      std::to_string(n - 1) + ")");
                 mesh.indices.push_back(static_cast<uint32_t>(index));
             }
-        for (size_t i = 0; i < object.normals.size(); ++i) {
-            if (is_zero(object.normals[i]))
-                fail(object.normals_where, "mesh.normals[" + std::to_string(i) + "] must not be the zero vector");
-            push_normal(mesh, to_world.apply_normal(object.normals[i]));
+        for (size_t i = 0; i < shape.normals.size(); ++i) {
+            if (is_zero(shape.normals[i]))
+                fail(shape.normals_where, "mesh.normals[" + std::to_string(i) + "] must not be the zero vector");
+            push_normal(mesh, to_world.apply_normal(shape.normals[i]));
         }
         mesh.object = add_id(object);
         add_mesh(std::move(mesh));
     }
 
-    void add_mesh_file(const ObjectDescription& object, const Transform& to_world) {
+    void add_mesh_file(const ObjectDescription& object, const MeshShape& shape, const Transform& to_world) {
         // A mistake inside the OBJ/MTL names that file; also say which scene line loads it.
         const auto with_reference = [&](const InputError& e) {
-            return InputError(e.where(), e.message() + " (mesh loaded at " + object.file.where.str() + ")");
+            return InputError(e.where(), e.message() + " (mesh loaded at " + shape.file.where.str() + ")");
         };
         MeshData data;
-        m_scene.mesh_files.push_back(object.file_path);
+        m_scene.mesh_files.push_back(shape.file_path);
         try {
             // With the object's own material the MTL files are not needed (nor read).
-            data = is_msh_file(object.file_path)
-                       ? load_msh_mesh(object.file_path, object.file.where)
-                       : load_obj_mesh(object.file_path, object.file.where, 0, !object.material);
+            data = is_msh_file(shape.file_path) ? load_msh_mesh(shape.file_path, shape.file.where)
+                                                : load_obj_mesh(shape.file_path, shape.file.where, 0, !object.material);
         } catch (const InputError& e) {
-            if (e.where().file == object.file.where.file) throw;
+            if (e.where().file == shape.file.where.file) throw;
             throw with_reference(e);
         }
         if (!m_prototype || m_prototype_shows_defaults) print_mesh_warnings(data);
@@ -457,10 +456,10 @@ private:
             std::vector<uint32_t> mtl_index;
             for (size_t i = 0; i < data.materials.size(); ++i) {
                 try {
-                    mtl_index.push_back(add_own_material(
-                        make_material(data.materials[i],
-                                      object.file_path + ": material '" + data.materials[i].name + "'"),
-                        data.materials[i].name));
+                    mtl_index.push_back(
+                        add_own_material(make_material(data.materials[i],
+                                                       shape.file_path + ": material '" + data.materials[i].name + "'"),
+                                         data.materials[i].name));
                 } catch (const InputError& e) {
                     throw with_reference(e);
                 }
@@ -468,7 +467,7 @@ private:
             for (const int32_t m : data.triangle_material) {
                 if (m < 0)
                     fail(object.where,
-                         "mesh: '" + object.file.value +
+                         "mesh: '" + shape.file.value +
                              "' has faces without an MTL material (usemtl), and the object has no 'material'");
                 mesh.triangle_materials.push_back(mtl_index[m]);
             }
@@ -480,7 +479,7 @@ private:
                 return to_world.apply_point(
                     {data.positions[3 * i], data.positions[3 * i + 1], data.positions[3 * i + 2]});
             },
-            object.file.where);
+            shape.file.where);
         if (!data.normals.empty()) {
             mesh.normals.reserve(3 * n);
             for (size_t i = 0; i < n; ++i)
@@ -500,7 +499,7 @@ private:
     /// instance is the object.
     uint32_t add_id(const ObjectDescription& object) {
         if (m_prototype) return 0;
-        m_scene.objects.push_back({object.type, object.where});
+        m_scene.objects.push_back({object.type(), object.where});
         return static_cast<uint32_t>(m_scene.objects.size());
     }
 
