@@ -36,7 +36,7 @@ extern "C" {
 /// `whitted check`: returns the exit status (0 pass, 1 images differ, 2 cannot check, 128 +
 /// the signal when interrupted) and prints its own messages.
 __attribute__((visibility("default"))) int whitted_run_check(const std::string& scene_path,
-                                                             const whitted::reference::CheckOptions& options,
+                                                             const whitted::reference::CheckRun& options,
                                                              const std::atomic<int>& signal) {
     try {
         if (options.terms) return whitted::reference::run_check_terms(scene_path, options) ? 0 : 1;
@@ -53,8 +53,8 @@ __attribute__((visibility("default"))) int whitted_run_check(const std::string& 
 /// back, and its errors as a value (exceptions stay on this side of dlopen). Returns 0 when the
 /// check ran (passed or not), 2 for bad input, 1 for a failure.
 __attribute__((visibility("default"))) int whitted_api_check(const std::string& scene_path,
-                                                             const whitted::reference::CheckOptions& options,
-                                                             whitted::reference::CheckResult& result,
+                                                             const whitted::reference::CheckRun& options,
+                                                             whitted::reference::CheckRecord& result,
                                                              std::string& verdict, whitted::api::Error& error) {
     try {
         result = whitted::reference::run_check(scene_path, options);

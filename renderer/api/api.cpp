@@ -91,14 +91,14 @@ std::optional<TileRect> crop_window(const Scene& scene, const RenderOptions& opt
     return TileRect{w.x, int(x_end), w.y, int(y_end)};
 }
 
-whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& options, LayerSet layers,
-                                      WorkExchange* exchange = nullptr) {
+whitted::RenderedTiles render_internal(const Scene& scene, const RenderOptions& options, LayerSet layers,
+                                       WorkExchange* exchange = nullptr) {
     const std::optional<TileRect> crop = crop_window(scene, options);
     const Accelerator& accelerator = impl_of(scene).accelerator(options.threads);
     // The progress callback may cancel too: then one flag of ours for both, set by either (the
     // caller's copied in by a watcher); without a callback the tiles check the caller's own.
     std::atomic<bool> stop{options.cancel && options.cancel->load()};
-    whitted::RenderOptions internal;
+    whitted::RenderJob internal;
     internal.threads = options.threads;
     internal.crop = crop;
     internal.layers = layers;
@@ -115,10 +115,10 @@ whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& o
         });
     }
     if (options.on_progress)
-        internal.on_progress = [&](const whitted::RenderProgress& p) {
-            if (!options.on_progress({p.tiles_done, p.tiles_total, p.rays, p.seconds})) stop.store(true);
+        internal.on_progress = [&](const Progress& progress) {
+            if (!options.on_progress(progress)) stop.store(true);
         };
-    whitted::RenderResult result;
+    whitted::RenderedTiles result;
     try {
         result = exchange ? whitted::render_distributed(impl_of(scene).scene, accelerator, internal, *exchange)
                           : whitted::render(impl_of(scene).scene, accelerator, internal);
@@ -133,7 +133,7 @@ whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& o
     return result;
 }
 
-RenderStats stats_of(const whitted::RenderResult& result) {
+RenderStats stats_of(const whitted::RenderedTiles& result) {
     return {result.rays.camera, result.rays.shadow, result.rays.reflected, result.seconds};
 }
 
@@ -463,7 +463,7 @@ Expected<RenderResult> render(const Scene& scene, const RenderOptions& options) 
 
 Expected<RenderResult> render_distributed(const Scene& scene, const RenderOptions& options, WorkExchange* exchange) {
     return guarded<RenderResult>("rendering " + scene.path(), [&]() -> Expected<RenderResult> {
-        whitted::RenderResult internal = render_internal(scene, options, layers_for(scene, options), exchange);
+        whitted::RenderedTiles internal = render_internal(scene, options, layers_for(scene, options), exchange);
         RenderResult result;
         result.image = std::move(internal.image);
         result.stats = stats_of(internal);
@@ -485,7 +485,7 @@ Expected<RenderStats> render_into(const Scene& scene, float* rgb, size_t floats,
     return guarded<RenderStats>("rendering " + scene.path(), [&]() -> Expected<RenderStats> {
         RenderOptions beauty = options;
         beauty.layers = {"none"};
-        whitted::RenderResult internal = render_internal(scene, beauty, LayerSet());
+        whitted::RenderedTiles internal = render_internal(scene, beauty, LayerSet());
         std::memcpy(rgb, internal.image.rgb.data(), needed * sizeof(float));
         if (internal.cancelled) return plain_error("the render was cancelled", Error::Kind::cancelled);
         return stats_of(internal);
@@ -531,7 +531,7 @@ Expected<std::string> write_povray(const Scene& scene, const std::string& pov_pa
 
 Expected<CheckResult> check(const std::string& scene_path, const CheckOptions& options) {
     return guarded<CheckResult>("checking " + scene_path, [&]() -> Expected<CheckResult> {
-        reference::CheckOptions internal;
+        reference::CheckRun internal;
         internal.threads = options.threads;
         internal.rule.tolerance = options.tolerance_codes / 65535.0;
         internal.rule.required_fraction = options.min_fraction;
@@ -542,9 +542,9 @@ Expected<CheckResult> check(const std::string& scene_path, const CheckOptions& o
         // Its errors come back as values: exceptions do not cross into the plug-in's own copy
         // of the libraries. 0: done, 2: bad input, 1: failure.
         using RunCheck =
-            int (*)(const std::string&, const reference::CheckOptions&, reference::CheckResult&, std::string&, Error&);
+            int (*)(const std::string&, const reference::CheckRun&, reference::CheckRecord&, std::string&, Error&);
         const auto run_check = reinterpret_cast<RunCheck>(image_io_plugin_symbol("whitted_api_check"));
-        reference::CheckResult result;
+        reference::CheckRecord result;
         std::string verdict;
         Error error;
         if (const int status = run_check(scene_path, internal, result, verdict, error); status != 0) {

@@ -518,7 +518,7 @@ int run_convert(const std::string& scene_path, const std::string& output) {
     }
 }
 
-int run_check_command(const std::string& scene_path, reference::CheckOptions options) {
+int run_check_command(const std::string& scene_path, reference::CheckRun options) {
     // Until the check has created its first file or directory a signal ends the program at once
     // (g_exit_on_signal, cleared by run_check); from then on it stops POV-Ray, the temporary
     // directories are removed and the exit status is 130/143.
@@ -526,7 +526,7 @@ int run_check_command(const std::string& scene_path, reference::CheckOptions opt
     options.exit_at_once = &g_exit_on_signal;
     install_signal_handlers();
     // `check` lives in the OpenImageIO plug-in (whitted/core/plugin.h); it prints its own errors.
-    using RunCheck = int (*)(const std::string&, const reference::CheckOptions&, const std::atomic<int>&);
+    using RunCheck = int (*)(const std::string&, const reference::CheckRun&, const std::atomic<int>&);
     try {
         const auto run_check = reinterpret_cast<RunCheck>(image_io_plugin_symbol("whitted_run_check"));
         return run_check(scene_path, options, g_signal);
@@ -755,7 +755,7 @@ int main(int argc, char** argv) {
         ->required();
 
     std::string check_scene;
-    reference::CheckOptions check_options;
+    reference::CheckRun check_options;
     double tolerance_codes = 2.0, max_error_codes = 64.0;
     CLI::App* check_cmd = app.add_subcommand(
         "check", "Render a scene with Whitted and with POV-Ray (converted) and compare them pixel by pixel");

@@ -4,13 +4,14 @@
 // Whitted's public C++ API (docs/library.md): load or build a scene, render it, write the image
 // through the colour pipeline, convert it to POV-Ray SDL, check it against POV-Ray.
 //
-// This header and the ones it includes (whitted/image.h, whitted/version.h) are all a caller
+// This header and the ones it includes (whitted/image.h, whitted/progress.h, whitted/version.h) are all a caller
 // needs: standard C++20 only, no Embree, TBB, YAML or OpenColorIO types. Every function that can
 // fail on the caller's input returns an Expected: the value, or an Error saying what is wrong and
 // where (FILE:LINE:COL). Nothing here throws for bad input; only misuse (value() of an error)
 // throws.
 
 #include "whitted/image.h"
+#include "whitted/progress.h"
 #include "whitted/version.h"
 
 #include <atomic>
@@ -226,13 +227,6 @@ public:
 private:
     struct Impl;
     std::unique_ptr<Impl> m_impl;
-};
-
-/// How far a render is.
-struct Progress {
-    size_t tiles_done = 0, tiles_total = 0;
-    uint64_t rays = 0;
-    double seconds = 0;
 };
 
 /// A rectangle of pixels: its top-left corner (column, row from the top-left, 0-based) and size.
