@@ -353,12 +353,13 @@ std::vector<TermScene> term_scenes(const SceneDescription& description) {
     return terms;
 }
 
-bool run_check_terms(const std::string& scene_path, const CheckRun& options) {
+std::string run_check_terms(const std::string& scene_path, const CheckRun& options, std::vector<std::string>& failed) {
     const InputFilesNoted inputs;  // for refuse_report_over_inputs
     const SceneDescription description = parse_scene_file(scene_path);
     const std::vector<TermScene> terms = term_scenes(description);
     if (terms.empty()) throw InputError({scene_path}, "check --terms: the scene has no term to isolate");
-    std::vector<std::string> failed, passed;
+    failed.clear();
+    std::vector<std::string> passed;
     for (const TermScene& term : terms) {
         CheckRun one = options;
         one.terms = false;
@@ -377,15 +378,14 @@ bool run_check_terms(const std::string& scene_path, const CheckRun& options) {
         for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
         return text;
     };
-    if (failed.empty())
-        std::printf("whitted check --terms %s: PASS: every term agrees with POV-Ray (%s)\n", scene_path.c_str(),
-                    list(passed).c_str());
-    else
-        std::printf("whitted check --terms %s: FAIL: %s disagree%s with POV-Ray%s\n", scene_path.c_str(),
-                    list(failed).c_str(), failed.size() == 1 ? "s" : "",
-                    passed.empty() ? "" : (" (" + list(passed) + " agree)").c_str());
+    const std::string verdict = failed.empty() ? "whitted check --terms " + scene_path +
+                                                     ": PASS: every term agrees with POV-Ray (" + list(passed) + ")"
+                                               : "whitted check --terms " + scene_path + ": FAIL: " + list(failed) +
+                                                     " disagree" + (failed.size() == 1 ? "s" : "") + " with POV-Ray" +
+                                                     (passed.empty() ? "" : " (" + list(passed) + " agree)");
+    std::printf("%s\n", verdict.c_str());
     std::fflush(stdout);
-    return failed.empty();
+    return verdict;
 }
 
 }  // namespace whitted::reference

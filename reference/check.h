@@ -76,8 +76,8 @@ struct TermScene {
 /// not in the description to change).
 std::vector<TermScene> term_scenes(const SceneDescription& description);
 /// `check --terms`: run_check on every term_scenes variant (reports in report_dir/<term>),
-/// then one line naming the terms that failed. True when all pass.
-bool run_check_terms(const std::string& scene_path, const CheckRun& options);
+/// then one line naming the terms that failed, printed and returned; `failed` gets their names.
+std::string run_check_terms(const std::string& scene_path, const CheckRun& options, std::vector<std::string>& failed);
 
 /// Writes ours.png, povray.png, diff.png (scaled heat map), ours.exr, povray.exr (both losslessly
 /// compressed), report-data.js, metrics.json and report.html into `dir`. `ours` and `theirs` are the images as

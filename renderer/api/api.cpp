@@ -6,6 +6,8 @@
 #include "converters/pov_writer.h"
 #include "reference/check.h"
 #include "whitted/core/plugin.h"
+#include "whitted/output/atomic_files.h"
+#include "whitted/output/color_management.h"
 #include "whitted/output/image_output.h"
 #include "whitted/render/distributed.h"
 #include "whitted/render/layers.h"
@@ -530,7 +532,9 @@ Expected<std::string> write_povray(const Scene& scene, const std::string& pov_pa
 }
 
 Expected<CheckResult> check(const std::string& scene_path, const CheckOptions& options) {
-    return guarded<CheckResult>("checking " + scene_path, [&]() -> Expected<CheckResult> {
+    // A scene or option it cannot check with is the caller's input (the plug-in missing
+    // included), as for every command.
+    try {
         reference::CheckRun internal;
         internal.threads = options.threads;
         internal.rule.tolerance = options.tolerance_codes / 65535.0;
@@ -538,27 +542,66 @@ Expected<CheckResult> check(const std::string& scene_path, const CheckOptions& o
         internal.rule.max_error = options.max_error_codes / 65535.0;
         internal.report_dir = options.report_dir;
         internal.quiet = options.quiet;
-        // `check` lives in the OpenImageIO plug-in (whitted/core/plugin.h), like the program's.
-        // Its errors come back as values: exceptions do not cross into the plug-in's own copy
-        // of the libraries. 0: done, 2: bad input, 1: failure.
-        using RunCheck =
-            int (*)(const std::string&, const reference::CheckRun&, reference::CheckRecord&, std::string&, Error&);
+        internal.layers = parse_layers(options.layers);
+        internal.terms = options.terms;
+        internal.povray_image = options.povray_image;
+        internal.exposure = options.exposure;
+        internal.cancel = options.cancel;
+        internal.exit_at_once = options.nothing_created_yet;
+        // `check` lives in the OpenImageIO plug-in (whitted/core/plugin.h). Its errors come back
+        // as values: exceptions do not cross into the plug-in's own copy of the libraries.
+        using RunCheck = bool (*)(const std::string&, const reference::CheckRun&, reference::CheckRecord&,
+                                  std::vector<std::string>&, std::string&, Error&);
         const auto run_check = reinterpret_cast<RunCheck>(image_io_plugin_symbol("whitted_api_check"));
         reference::CheckRecord result;
-        std::string verdict;
-        Error error;
-        if (const int status = run_check(scene_path, internal, result, verdict, error); status != 0) {
-            error.kind = status == 2 ? Error::Kind::bad_input : Error::Kind::failure;
-            return error;
-        }
+        std::vector<std::string> failed_terms;
         CheckResult out;
+        Error error;
+        if (!run_check(scene_path, internal, result, failed_terms, out.verdict, error)) return error;
         out.passed = result.passed;
+        if (options.terms) {
+            out.failures = failed_terms;
+            return out;
+        }
         out.fraction_within = result.comparison.fraction_within();
         out.max_error_codes = result.comparison.max_error * 65535.0;
         out.psnr = result.comparison.psnr;
         out.failures = result.failures;
-        out.verdict = verdict;
         return out;
+    } catch (...) {
+        return current_error({"checking " + scene_path, "", Error::Kind::bad_input});
+    }
+}
+
+Expected<Comparison> compare_image_files(const std::string& first, const std::string& second, const PassRule& rule,
+                                         bool clip) {
+    try {
+        // In the OpenImageIO plug-in, like check; its errors come back as values.
+        using RunCompare = bool (*)(const std::string&, const std::string&, const PassRule&, bool, Comparison&, Error&);
+        const auto run_compare = reinterpret_cast<RunCompare>(image_io_plugin_symbol("whitted_api_compare"));
+        Comparison result;
+        Error error;
+        if (!run_compare(first, second, rule, clip, result, error)) return error;
+        return result;
+    } catch (...) {  // the plug-in cannot be loaded
+        return current_error({"comparing " + first + " and " + second, "", Error::Kind::bad_input});
+    }
+}
+
+Expected<std::string> describe_colour_config(const std::string& config_path) {
+    return guarded<std::string>("reading the colour config", [&]() -> Expected<std::string> {
+        return DisplayTransform::describe_config(config_path);
+    });
+}
+
+Expected<void> write_colour_config(const std::string& path) {
+    return guarded<void>("writing the colour config", [&]() -> Expected<void> {
+        // Before a byte is written; /dev/full stays a device.
+        check_can_write(path);
+        refuse_symlink_target(path);
+        const std::string text = DisplayTransform::builtin_config_text();
+        write_files_atomically({{path, text}});
+        return {};
     });
 }
 
