@@ -82,7 +82,7 @@ std::string rgb_codes(const float* v) {
     return fmt::format("{:.1f} {:.1f} {:.1f}", double(v[0]) * 65535.0, double(v[1]) * 65535.0, double(v[2]) * 65535.0);
 }
 
-void print_table(const std::string& scene_path, const CheckResult& r, const CheckOptions& options) {
+void print_table(const std::string& scene_path, const CheckRecord& r, const CheckRun& options) {
     const ImageComparison& c = r.comparison;
     const PassRule& rule = options.rule;
     std::string out;
@@ -118,13 +118,13 @@ void print_table(const std::string& scene_path, const CheckResult& r, const Chec
     std::fputs(out.c_str(), stdout);
 }
 
-void throw_if_cancelled(const CheckOptions& options) {
+void throw_if_cancelled(const CheckRun& options) {
     if (options.cancel && options.cancel->load()) throw Interrupted();
 }
 
 }  // namespace
 
-std::string verdict_line(const std::string& scene_path, const CheckResult& r, const CheckOptions& options) {
+std::string verdict_line(const std::string& scene_path, const CheckRecord& r, const CheckRun& options) {
     // No figures when the images could not be compared at all (their sizes differ).
     const bool compared = r.comparison.pixels > 0;
     return verdict_text(scene_path, compared ? verdict_figures(r.comparison, options.rule) : std::string(), r.failures);
@@ -134,7 +134,7 @@ namespace {
 
 /// A report directory that cannot be one (a file, or under one) is a usage error found before
 /// the scene is read and rendered, not after (it took 28-38 s on a large scene).
-void check_report_dir(const CheckOptions& options) {
+void check_report_dir(const CheckRun& options) {
     if (options.report_dir.empty()) return;
     std::error_code error;
     for (fs::path at = fs::absolute(options.report_dir, error); !error && !at.empty(); at = at.parent_path()) {
@@ -159,7 +159,7 @@ constexpr const char* report_files[] = {pov_name,   ini_name,       povray_image
 /// A report file that is one of the check's inputs (the scene, a mesh or MTL file, by any name:
 /// a scene copied to `r/metrics.json`) is a usage error before the render: the report would
 /// replace it.
-void refuse_report_over_inputs(const CheckOptions& options) {
+void refuse_report_over_inputs(const CheckRun& options) {
     if (options.report_dir.empty()) return;
     for (const char* name : report_files) {
         const fs::path target = fs::path(options.report_dir) / name;
@@ -171,15 +171,15 @@ void refuse_report_over_inputs(const CheckOptions& options) {
 
 }  // namespace
 
-CheckResult run_check(const std::string& scene_path, const CheckOptions& options) {
+CheckRecord run_check(const std::string& scene_path, const CheckRun& options) {
     check_report_dir(options);
     const InputFilesNoted inputs;  // for refuse_report_over_inputs
     return run_check(parse_scene_file(scene_path), scene_path, options);
 }
 
-CheckResult run_check(const SceneDescription& description, const std::string& scene_path, const CheckOptions& options) {
+CheckRecord run_check(const SceneDescription& description, const std::string& scene_path, const CheckRun& options) {
     check_report_dir(options);
-    CheckResult result;
+    CheckRecord result;
 
     // 1. Whitted, as `whitted render` does it, with POV-Ray's intersection decisions
     //    (render.intersection: povray), so that the two can agree pixel by pixel where an exact
@@ -190,10 +190,10 @@ CheckResult run_check(const SceneDescription& description, const std::string& sc
     Image ours;
     {
         const Accelerator accelerator(scene, options.threads);
-        RenderOptions render_options;
+        RenderJob render_options;
         render_options.threads = options.threads;
         render_options.layers = options.layers;
-        RenderResult rendered = render(scene, accelerator, render_options);
+        RenderedTiles rendered = render(scene, accelerator, render_options);
         result.whitted_seconds = rendered.seconds;
         ours = std::move(rendered.image);
     }
@@ -353,14 +353,15 @@ std::vector<TermScene> term_scenes(const SceneDescription& description) {
     return terms;
 }
 
-bool run_check_terms(const std::string& scene_path, const CheckOptions& options) {
+std::string run_check_terms(const std::string& scene_path, const CheckRun& options, std::vector<std::string>& failed) {
     const InputFilesNoted inputs;  // for refuse_report_over_inputs
     const SceneDescription description = parse_scene_file(scene_path);
     const std::vector<TermScene> terms = term_scenes(description);
     if (terms.empty()) throw InputError({scene_path}, "check --terms: the scene has no term to isolate");
-    std::vector<std::string> failed, passed;
+    failed.clear();
+    std::vector<std::string> passed;
     for (const TermScene& term : terms) {
-        CheckOptions one = options;
+        CheckRun one = options;
         one.terms = false;
         if (!options.report_dir.empty()) {
             std::string folder = term.term;
@@ -369,7 +370,7 @@ bool run_check_terms(const std::string& scene_path, const CheckOptions& options)
         }
         std::printf("term '%s':\n", term.term.c_str());
         std::fflush(stdout);
-        const CheckResult result = run_check(term.description, scene_path + " [" + term.term + " only]", one);
+        const CheckRecord result = run_check(term.description, scene_path + " [" + term.term + " only]", one);
         (result.passed ? passed : failed).push_back(term.term);
     }
     const auto list = [](const std::vector<std::string>& names) {
@@ -377,15 +378,14 @@ bool run_check_terms(const std::string& scene_path, const CheckOptions& options)
         for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
         return text;
     };
-    if (failed.empty())
-        std::printf("whitted check --terms %s: PASS: every term agrees with POV-Ray (%s)\n", scene_path.c_str(),
-                    list(passed).c_str());
-    else
-        std::printf("whitted check --terms %s: FAIL: %s disagree%s with POV-Ray%s\n", scene_path.c_str(),
-                    list(failed).c_str(), failed.size() == 1 ? "s" : "",
-                    passed.empty() ? "" : (" (" + list(passed) + " agree)").c_str());
+    const std::string verdict = failed.empty() ? "whitted check --terms " + scene_path +
+                                                     ": PASS: every term agrees with POV-Ray (" + list(passed) + ")"
+                                               : "whitted check --terms " + scene_path + ": FAIL: " + list(failed) +
+                                                     " disagree" + (failed.size() == 1 ? "s" : "") + " with POV-Ray" +
+                                                     (passed.empty() ? "" : " (" + list(passed) + " agree)");
+    std::printf("%s\n", verdict.c_str());
     std::fflush(stdout);
-    return failed.empty();
+    return verdict;
 }
 
 }  // namespace whitted::reference

@@ -18,7 +18,9 @@ struct Interrupted : std::runtime_error {
     Interrupted() : std::runtime_error("interrupted") {}
 };
 
-struct CheckOptions {
+/// Everything one run of the check needs: api::CheckOptions (which the API turns into this) in
+/// the comparison's own units, plus what only the `whitted` program and the report use.
+struct CheckRun {
     std::string report_dir;  ///< empty: no report
     PassRule rule;
     size_t worst_count = 10;  ///< pixels listed by the report
@@ -42,7 +44,9 @@ struct CheckOptions {
     std::atomic<bool>* exit_at_once = nullptr;
 };
 
-struct CheckResult {
+/// Everything one run of the check found, for the table, the report and the verdict line;
+/// api::CheckResult is the part a caller of the library is given.
+struct CheckRecord {
     ImageComparison comparison;
     double exposure = 1;  ///< the scale both images were compared at (< 1 for scenes brighter than 1)
     bool passed = false;
@@ -56,9 +60,9 @@ struct CheckResult {
 
 /// Renders the scene with Whitted and (converted) with POV-Ray, compares them, prints the
 /// figures and writes the report. Throws InputError / std::runtime_error on errors.
-CheckResult run_check(const std::string& scene_path, const CheckOptions& options);
+CheckRecord run_check(const std::string& scene_path, const CheckRun& options);
 /// The same for a description already read; `label` names it in messages and the report.
-CheckResult run_check(const SceneDescription& description, const std::string& label, const CheckOptions& options);
+CheckRecord run_check(const SceneDescription& description, const std::string& label, const CheckRun& options);
 
 /// One term-isolated variant of a scene (`check --terms`).
 struct TermScene {
@@ -72,19 +76,19 @@ struct TermScene {
 /// not in the description to change).
 std::vector<TermScene> term_scenes(const SceneDescription& description);
 /// `check --terms`: run_check on every term_scenes variant (reports in report_dir/<term>),
-/// then one line naming the terms that failed. True when all pass.
-bool run_check_terms(const std::string& scene_path, const CheckOptions& options);
+/// then one line naming the terms that failed, printed and returned; `failed` gets their names.
+std::string run_check_terms(const std::string& scene_path, const CheckRun& options, std::vector<std::string>& failed);
 
 /// Writes ours.png, povray.png, diff.png (scaled heat map), ours.exr, povray.exr (both losslessly
 /// compressed), report-data.js, metrics.json and report.html into `dir`. `ours` and `theirs` are the images as
 /// compared, i.e. already multiplied by result.exposure; the EXRs are written at the scene's own scale (ours.exr is
 /// what `whitted render` writes), the PNGs and the heat map at the compared scale.
 void write_report(const std::string& dir, const std::string& scene_path, const Image& ours, const Image& theirs,
-                  const CheckResult& result, const CheckOptions& options);
+                  const CheckRecord& result, const CheckRun& options);
 
 /// The one-line verdict printed last by `whitted check` (scripts/validate reads it), e.g.
 /// "PASS scene.yaml: 100.000% of pixels within 2/65535 (99.9% required), max 1.0 codes (cap 64)",
 /// or with "; failed: cap (max 1000.0 codes > 64)" and the like for each rule broken.
-std::string verdict_line(const std::string& scene_path, const CheckResult& result, const CheckOptions& options);
+std::string verdict_line(const std::string& scene_path, const CheckRecord& result, const CheckRun& options);
 
 }  // namespace whitted::reference

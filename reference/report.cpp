@@ -210,8 +210,8 @@ nlohmann::json encoded_image(const std::vector<float>& values, int width, int he
 /// images are those compared (at the compared exposure); the colour render layers (when the
 /// check rendered with --layers) are multiplied by the same exposure, so that they add up to
 /// Whitted's compared image as the EXR's layers add up to its R, G, B.
-std::string report_data_js(const std::string& scene_path, const Image& ours, const Image& theirs, const CheckResult& r,
-                           const CheckOptions& options) {
+std::string report_data_js(const std::string& scene_path, const Image& ours, const Image& theirs, const CheckRecord& r,
+                           const CheckRun& options) {
     const ImageComparison& c = r.comparison;
     nlohmann::json j;
     j["format"] = 2;
@@ -244,7 +244,7 @@ std::string report_data_js(const std::string& scene_path, const Image& ours, con
            j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + ";\n";
 }
 
-nlohmann::json metrics_json(const std::string& scene_path, const CheckResult& r, const CheckOptions& options) {
+nlohmann::json metrics_json(const std::string& scene_path, const CheckRecord& r, const CheckRun& options) {
     const ImageComparison& c = r.comparison;
     nlohmann::json j;
     j["scene"] = fs::absolute(scene_path).string();
@@ -284,7 +284,7 @@ nlohmann::json metrics_json(const std::string& scene_path, const CheckResult& r,
                          {"error_codes", w.error * 65535},
                          {"whitted", rgb_json(w.ours)},
                          {"povray", rgb_json(w.theirs)}});
-    j["worst_pixels"] = worst;  // largest error first, at most CheckOptions::worst_count
+    j["worst_pixels"] = worst;  // largest error first, at most CheckRun::worst_count
     j["whitted_seconds"] = r.whitted_seconds;
     // The intersection rules Whitted rendered with (docs/scene-format.md, render.intersection).
     j["whitted_intersection"] = "povray";
@@ -369,8 +369,8 @@ std::string explore_section(const ImageComparison& c, double tolerance_codes) {
     return h;
 }
 
-std::string report_html(const std::string& dir, const std::string& scene_path, const CheckResult& r,
-                        const CheckOptions& options) {
+std::string report_html(const std::string& dir, const std::string& scene_path, const CheckRecord& r,
+                        const CheckRun& options) {
     const ImageComparison& c = r.comparison;
     const std::string verdict = verdict_line(scene_path, r, options);
     const double tolerance_codes = options.rule.tolerance * 65535;
@@ -548,7 +548,7 @@ kbd { border: 1px solid #bbb; border-radius: 3px; padding: 0 .25em; font-size: .
 }  // namespace
 
 void write_report(const std::string& dir, const std::string& scene_path, const Image& ours, const Image& theirs,
-                  const CheckResult& result, const CheckOptions& options) {
+                  const CheckRecord& result, const CheckRun& options) {
     const fs::path d(dir);
     std::error_code error;
     fs::create_directories(d, error);

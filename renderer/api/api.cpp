@@ -6,6 +6,8 @@
 #include "converters/pov_writer.h"
 #include "reference/check.h"
 #include "whitted/core/plugin.h"
+#include "whitted/output/atomic_files.h"
+#include "whitted/output/color_management.h"
 #include "whitted/output/image_output.h"
 #include "whitted/render/distributed.h"
 #include "whitted/render/layers.h"
@@ -91,14 +93,14 @@ std::optional<TileRect> crop_window(const Scene& scene, const RenderOptions& opt
     return TileRect{w.x, int(x_end), w.y, int(y_end)};
 }
 
-whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& options, LayerSet layers,
-                                      WorkExchange* exchange = nullptr) {
+whitted::RenderedTiles render_internal(const Scene& scene, const RenderOptions& options, LayerSet layers,
+                                       WorkExchange* exchange = nullptr) {
     const std::optional<TileRect> crop = crop_window(scene, options);
     const Accelerator& accelerator = impl_of(scene).accelerator(options.threads);
     // The progress callback may cancel too: then one flag of ours for both, set by either (the
     // caller's copied in by a watcher); without a callback the tiles check the caller's own.
     std::atomic<bool> stop{options.cancel && options.cancel->load()};
-    whitted::RenderOptions internal;
+    whitted::RenderJob internal;
     internal.threads = options.threads;
     internal.crop = crop;
     internal.layers = layers;
@@ -115,10 +117,10 @@ whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& o
         });
     }
     if (options.on_progress)
-        internal.on_progress = [&](const whitted::RenderProgress& p) {
-            if (!options.on_progress({p.tiles_done, p.tiles_total, p.rays, p.seconds})) stop.store(true);
+        internal.on_progress = [&](const Progress& progress) {
+            if (!options.on_progress(progress)) stop.store(true);
         };
-    whitted::RenderResult result;
+    whitted::RenderedTiles result;
     try {
         result = exchange ? whitted::render_distributed(impl_of(scene).scene, accelerator, internal, *exchange)
                           : whitted::render(impl_of(scene).scene, accelerator, internal);
@@ -133,7 +135,7 @@ whitted::RenderResult render_internal(const Scene& scene, const RenderOptions& o
     return result;
 }
 
-RenderStats stats_of(const whitted::RenderResult& result) {
+RenderStats stats_of(const whitted::RenderedTiles& result) {
     return {result.rays.camera, result.rays.shadow, result.rays.reflected, result.seconds};
 }
 
@@ -454,7 +456,7 @@ Expected<RenderResult> render(const Scene& scene, const RenderOptions& options) 
 
 Expected<RenderResult> render_distributed(const Scene& scene, const RenderOptions& options, WorkExchange* exchange) {
     return guarded<RenderResult>("rendering " + scene.path(), [&]() -> Expected<RenderResult> {
-        whitted::RenderResult internal = render_internal(scene, options, layers_for(scene, options), exchange);
+        whitted::RenderedTiles internal = render_internal(scene, options, layers_for(scene, options), exchange);
         RenderResult result;
         result.image = std::move(internal.image);
         result.stats = stats_of(internal);
@@ -476,7 +478,7 @@ Expected<RenderStats> render_into(const Scene& scene, float* rgb, size_t floats,
     return guarded<RenderStats>("rendering " + scene.path(), [&]() -> Expected<RenderStats> {
         RenderOptions beauty = options;
         beauty.layers = {"none"};
-        whitted::RenderResult internal = render_internal(scene, beauty, LayerSet());
+        whitted::RenderedTiles internal = render_internal(scene, beauty, LayerSet());
         std::memcpy(rgb, internal.image.rgb.data(), needed * sizeof(float));
         if (internal.cancelled) return plain_error("the render was cancelled", Error::Kind::cancelled);
         return stats_of(internal);
@@ -521,35 +523,76 @@ Expected<std::string> write_povray(const Scene& scene, const std::string& pov_pa
 }
 
 Expected<CheckResult> check(const std::string& scene_path, const CheckOptions& options) {
-    return guarded<CheckResult>("checking " + scene_path, [&]() -> Expected<CheckResult> {
-        reference::CheckOptions internal;
+    // A scene or option it cannot check with is the caller's input (the plug-in missing
+    // included), as for every command.
+    try {
+        reference::CheckRun internal;
         internal.threads = options.threads;
         internal.rule.tolerance = options.tolerance_codes / 65535.0;
         internal.rule.required_fraction = options.min_fraction;
         internal.rule.max_error = options.max_error_codes / 65535.0;
         internal.report_dir = options.report_dir;
         internal.quiet = options.quiet;
-        // `check` lives in the OpenImageIO plug-in (whitted/core/plugin.h), like the program's.
-        // Its errors come back as values: exceptions do not cross into the plug-in's own copy
-        // of the libraries. 0: done, 2: bad input, 1: failure.
-        using RunCheck =
-            int (*)(const std::string&, const reference::CheckOptions&, reference::CheckResult&, std::string&, Error&);
+        internal.layers = parse_layers(options.layers);
+        internal.terms = options.terms;
+        internal.povray_image = options.povray_image;
+        internal.exposure = options.exposure;
+        internal.cancel = options.cancel;
+        internal.exit_at_once = options.nothing_created_yet;
+        // `check` lives in the OpenImageIO plug-in (whitted/core/plugin.h). Its errors come back
+        // as values: exceptions do not cross into the plug-in's own copy of the libraries.
+        using RunCheck = bool (*)(const std::string&, const reference::CheckRun&, reference::CheckRecord&,
+                                  std::vector<std::string>&, std::string&, Error&);
         const auto run_check = reinterpret_cast<RunCheck>(image_io_plugin_symbol("whitted_api_check"));
-        reference::CheckResult result;
-        std::string verdict;
-        Error error;
-        if (const int status = run_check(scene_path, internal, result, verdict, error); status != 0) {
-            error.kind = status == 2 ? Error::Kind::bad_input : Error::Kind::failure;
-            return error;
-        }
+        reference::CheckRecord result;
+        std::vector<std::string> failed_terms;
         CheckResult out;
+        Error error;
+        if (!run_check(scene_path, internal, result, failed_terms, out.verdict, error)) return error;
         out.passed = result.passed;
+        if (options.terms) {
+            out.failures = failed_terms;
+            return out;
+        }
         out.fraction_within = result.comparison.fraction_within();
         out.max_error_codes = result.comparison.max_error * 65535.0;
         out.psnr = result.comparison.psnr;
         out.failures = result.failures;
-        out.verdict = verdict;
         return out;
+    } catch (...) {
+        return current_error({"checking " + scene_path, "", Error::Kind::bad_input});
+    }
+}
+
+Expected<Comparison> compare_image_files(const std::string& first, const std::string& second, const PassRule& rule,
+                                         bool clip) {
+    try {
+        // In the OpenImageIO plug-in, like check; its errors come back as values.
+        using RunCompare = bool (*)(const std::string&, const std::string&, const PassRule&, bool, Comparison&, Error&);
+        const auto run_compare = reinterpret_cast<RunCompare>(image_io_plugin_symbol("whitted_api_compare"));
+        Comparison result;
+        Error error;
+        if (!run_compare(first, second, rule, clip, result, error)) return error;
+        return result;
+    } catch (...) {  // the plug-in cannot be loaded
+        return current_error({"comparing " + first + " and " + second, "", Error::Kind::bad_input});
+    }
+}
+
+Expected<std::string> describe_colour_config(const std::string& config_path) {
+    return guarded<std::string>("reading the colour config", [&]() -> Expected<std::string> {
+        return DisplayTransform::describe_config(config_path);
+    });
+}
+
+Expected<void> write_colour_config(const std::string& path) {
+    return guarded<void>("writing the colour config", [&]() -> Expected<void> {
+        // Before a byte is written; /dev/full stays a device.
+        check_can_write(path);
+        refuse_symlink_target(path);
+        const std::string text = DisplayTransform::builtin_config_text();
+        write_files_atomically({{path, text}});
+        return {};
     });
 }
 

@@ -9,7 +9,6 @@
 
 #include "api/api_internal.h"
 #include "converters/yaml_writer.h"
-#include "explain_command.h"
 #include "live_page_html.h"
 #include "whitted/scene/description.h"
 #include "whitted/scene/errors.h"
@@ -505,13 +504,24 @@ int run_live(const LiveArguments& args) {
             return member->get<int64_t>();
         };
         const int64_t x = coordinate("x"), y = coordinate("y");
-        const SceneDescription description = edited_description(snapshot.text, state.path(), values_of(body));
-        const Scene scene = validate_scene(description);
-        if (x < 0 || y < 0 || x >= scene.width || y >= scene.height)
+        auto impl = std::make_unique<api::Scene::Impl>();
+        impl->description = edited_description(snapshot.text, state.path(), values_of(body));
+        impl->scene = validate_scene(impl->description);
+        const api::Scene scene(std::move(impl));
+        if (x < 0 || y < 0 || x >= scene.width() || y >= scene.height())
             throw BadRequest("pixel " + std::to_string(x) + "," + std::to_string(y) + " is outside the " +
-                             std::to_string(scene.width) + "x" + std::to_string(scene.height) + " image");
+                             std::to_string(scene.width()) + "x" + std::to_string(scene.height()) + " image");
         std::lock_guard lock(render_mutex);
-        response.set_content(explain_pixel_json(scene, state.path(), int(x), int(y), args.threads), "application/json");
+        api::ExplainOptions options;
+        options.threads = args.threads;
+        api::Expected<std::string> explained = api::explain(scene, int(x), int(y), options);
+        if (!explained) {
+            const api::Error& error = explained.error();
+            return send_error(response, error.kind == api::Error::Kind::bad_input ? 422 : 500, error.what());
+        }
+        std::string text = std::move(explained).value();
+        text.pop_back();  // the newline `whitted explain --json` ends its output with
+        response.set_content(text, "application/json");
     });
 
     // The edited scene written to a new file, in Whitted's own format; an existing file only

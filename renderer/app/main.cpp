@@ -8,10 +8,8 @@
 #include "converters/yaml_writer.h"
 #include "explain_command.h"
 #include "live_command.h"
-#include "reference/check.h"
 #include "whitted/core/plugin.h"
 #include "whitted/output/atomic_files.h"
-#include "whitted/output/color_management.h"
 #include "whitted/output/image_output.h"
 #include "whitted/render/accelerator.h"
 #include "whitted/render/distributed.h"
@@ -518,51 +516,44 @@ int run_convert(const std::string& scene_path, const std::string& output) {
     }
 }
 
-int run_check_command(const std::string& scene_path, reference::CheckOptions options) {
+int run_check_command(const std::string& scene_path, api::CheckOptions options) {
     // Until the check has created its first file or directory a signal ends the program at once
-    // (g_exit_on_signal, cleared by run_check); from then on it stops POV-Ray, the temporary
+    // (g_exit_on_signal, cleared by api::check); from then on it stops POV-Ray, the temporary
     // directories are removed and the exit status is 130/143.
     options.cancel = &g_cancel;
-    options.exit_at_once = &g_exit_on_signal;
+    options.nothing_created_yet = &g_exit_on_signal;
     install_signal_handlers();
-    // `check` lives in the OpenImageIO plug-in (whitted/core/plugin.h); it prints its own errors.
-    using RunCheck = int (*)(const std::string&, const reference::CheckOptions&, const std::atomic<int>&);
-    try {
-        const auto run_check = reinterpret_cast<RunCheck>(image_io_plugin_symbol("whitted_run_check"));
-        return run_check(scene_path, options, g_signal);
-    } catch (...) {  // the plug-in cannot be loaded
-        return api::report(api::current_error({"checking " + scene_path, "", api::Error::Kind::bad_input}));
+    const api::Expected<api::CheckResult> checked = api::check(scene_path, options);
+    if (!checked) {
+        if (checked.error().kind != api::Error::Kind::cancelled) return api::report(checked.error());
+        std::fprintf(stderr, "whitted: %s\n", checked.error().message.c_str());
+        return 128 + (g_signal.load() ? g_signal.load() : SIGINT);
     }
+    return checked->passed ? exit_ok : exit_failure;
 }
 
-int run_compare_command(const std::string& first, const std::string& second, const reference::PassRule& rule,
-                        bool clip) {
-    using RunCompare = int (*)(const std::string&, const std::string&, const reference::PassRule&, bool);
-    try {
-        const auto run_compare = reinterpret_cast<RunCompare>(image_io_plugin_symbol("whitted_run_compare"));
-        return run_compare(first, second, rule, clip);
-    } catch (...) {  // the plug-in cannot be loaded
-        return api::report(
-            api::current_error({"comparing " + first + " and " + second, "", api::Error::Kind::bad_input}));
-    }
+int run_compare_command(const std::string& first, const std::string& second, const api::PassRule& rule, bool clip) {
+    const api::Expected<api::Comparison> compared = api::compare_image_files(first, second, rule, clip);
+    if (!compared) return api::report(compared.error());
+    if (!compared->first_meaning.empty())
+        std::printf("%s: %s\n%s: %s\n", first.c_str(), compared->first_meaning.c_str(), second.c_str(),
+                    compared->second_meaning.c_str());
+    std::printf("%s\n", compared->verdict.c_str());
+    return compared->passed ? exit_ok : exit_failure;
 }
 
 int run_colour(bool list, const std::string& config, const std::string& write_config) {
-    try {
-        if (!config.empty() && !list) throw std::invalid_argument("--ocio-config goes with --list");
-        if (!write_config.empty()) {
-            // Before a byte is written; /dev/full stays a device.
-            check_can_write(write_config);
-            refuse_symlink_target(write_config);
-            const std::string text = DisplayTransform::builtin_config_text();
-            write_files_atomically({{write_config, text}});
-            std::fprintf(stderr, "whitted: wrote the built-in OpenColorIO config to %s\n", write_config.c_str());
-        }
-        if (list) std::fputs(DisplayTransform::describe_config(config).c_str(), stdout);
-        return exit_ok;
-    } catch (...) {
-        return api::report(api::current_error({"writing the colour config"}));
+    if (!config.empty() && !list) return api::report(api::Error{"--ocio-config goes with --list"});
+    if (!write_config.empty()) {
+        if (const auto written = api::write_colour_config(write_config); !written) return api::report(written.error());
+        std::fprintf(stderr, "whitted: wrote the built-in OpenColorIO config to %s\n", write_config.c_str());
     }
+    if (list) {
+        const api::Expected<std::string> text = api::describe_colour_config(config);
+        if (!text) return api::report(text.error());
+        std::fputs(text->c_str(), stdout);
+    }
+    return exit_ok;
 }
 
 /// `whitted --version`: the program's version and, since it decides which of Embree's code
@@ -755,24 +746,23 @@ int main(int argc, char** argv) {
         ->required();
 
     std::string check_scene;
-    reference::CheckOptions check_options;
-    double tolerance_codes = 2.0, max_error_codes = 64.0;
+    api::CheckOptions check_options;
+    check_options.quiet = false;
     CLI::App* check_cmd = app.add_subcommand(
         "check", "Render a scene with Whitted and with POV-Ray (converted) and compare them pixel by pixel");
     check_cmd->add_option("scene", check_scene, "Scene file")->required()->check(CLI::ExistingFile);
     check_cmd->add_option("--report", check_options.report_dir,
                           "Write images, a difference heat map, metrics.json and report.html (open it from the disk: "
                           "wipe, zoom, pixel probe; docs/validation.md) into this directory");
-    check_cmd->add_option("--tolerance", tolerance_codes, "Per-channel tolerance in 16-bit codes (1/65535)")
+    check_cmd
+        ->add_option("--tolerance", check_options.tolerance_codes, "Per-channel tolerance in 16-bit codes (1/65535)")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
-    check_cmd
-        ->add_option("--min-fraction", check_options.rule.required_fraction,
-                     "Share of pixels that must be within tolerance")
+    check_cmd->add_option("--min-fraction", check_options.min_fraction, "Share of pixels that must be within tolerance")
         ->capture_default_str()
         ->check(CLI::Range(0.0, 1.0));
     check_cmd
-        ->add_option("--max-error", max_error_codes,
+        ->add_option("--max-error", check_options.max_error_codes,
                      "Hard cap: no channel of any pixel may differ by more than this many 16-bit codes")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
@@ -783,9 +773,8 @@ int main(int argc, char** argv) {
                         "Check term by term: the scene with only ambient, only diffuse, only specular, and each "
                         "light alone (several lights), each against POV-Ray; the last line names the terms "
                         "that disagree");
-    std::vector<std::string> check_layers;
     check_cmd
-        ->add_option("--layers", check_layers,
+        ->add_option("--layers", check_options.layers,
                      "Render Whitted's image with these render layers (as `render --layers`) and compare its "
                      "beauty, then the float sum of the colour layers")
         ->delimiter(',');
@@ -815,7 +804,7 @@ int main(int argc, char** argv) {
     colour_cmd->require_option(1, 2);
 
     std::string compare_first, compare_second;
-    double compare_tolerance = 2.0, compare_fraction = 0.999, compare_max_error = 64.0;
+    api::PassRule compare_rule;
     bool compare_clip = false;
     CLI::App* compare_cmd =
         app.add_subcommand("compare",
@@ -823,14 +812,16 @@ int main(int argc, char** argv) {
                            "turned into linear Rec.709 from its colour metadata");
     compare_cmd->add_option("first", compare_first, "Image")->required()->check(CLI::ExistingFile);
     compare_cmd->add_option("second", compare_second, "Image of the same size")->required()->check(CLI::ExistingFile);
-    compare_cmd->add_option("--tolerance", compare_tolerance, "Per-channel tolerance in 16-bit codes (1/65535)")
+    compare_cmd
+        ->add_option("--tolerance", compare_rule.tolerance_codes, "Per-channel tolerance in 16-bit codes (1/65535)")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
-    compare_cmd->add_option("--min-fraction", compare_fraction, "Share of pixels that must be within tolerance")
+    compare_cmd
+        ->add_option("--min-fraction", compare_rule.min_fraction, "Share of pixels that must be within tolerance")
         ->capture_default_str()
         ->check(CLI::Range(0.0, 1.0));
     compare_cmd
-        ->add_option("--max-error", compare_max_error,
+        ->add_option("--max-error", compare_rule.max_error_codes,
                      "Hard cap: no channel of any pixel may differ by more than this many 16-bit codes")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
@@ -879,19 +870,6 @@ int main(int argc, char** argv) {
     }
     if (*convert_cmd) return run_convert(convert_scene, convert_output);
     if (*colour_cmd) return run_colour(colour_list, colour_config, colour_write);
-    if (*compare_cmd) {
-        reference::PassRule rule;
-        rule.tolerance = compare_tolerance / 65535.0;
-        rule.required_fraction = compare_fraction;
-        rule.max_error = compare_max_error / 65535.0;
-        return run_compare_command(compare_first, compare_second, rule, compare_clip);
-    }
-    try {
-        check_options.layers = parse_layers(check_layers);
-    } catch (...) {
-        return api::report(api::current_error({"reading --layers", "", api::Error::Kind::bad_input}));
-    }
-    check_options.rule.tolerance = tolerance_codes / 65535.0;
-    check_options.rule.max_error = max_error_codes / 65535.0;
+    if (*compare_cmd) return run_compare_command(compare_first, compare_second, compare_rule, compare_clip);
     return run_check_command(check_scene, check_options);
 }

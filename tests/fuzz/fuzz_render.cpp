@@ -38,9 +38,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         scene.samples = std::min(scene.samples, 2);
         scene.max_depth = std::min(scene.max_depth, 3);
         const Accelerator accelerator(scene, 1);
-        RenderOptions options;
+        RenderJob options;
         options.threads = 1;
-        const RenderResult result = render(scene, accelerator, options);
+        const RenderedTiles result = render(scene, accelerator, options);
         if (result.image.width != scene.width || result.image.height != scene.height) __builtin_trap();
         // Every radiance the lecture's model gives is a number and not negative: its terms are
         // products and sums of non-negative numbers, clamped by max(0, ·). (Not always finite: a

@@ -16,7 +16,7 @@ rm -rf "$work"
 mkdir -p "$work"
 prefix="$work/prefix"
 cmake --install "$build" --prefix "$prefix" >"$work/install.log"
-for f in include/whitted/whitted.h include/whitted/image.h include/whitted/version.h \
+for f in include/whitted/whitted.h include/whitted/image.h include/whitted/progress.h include/whitted/version.h \
          "$libdir/cmake/Whitted/WhittedConfig.cmake" "$libdir/cmake/Whitted/WhittedConfigVersion.cmake" \
          "$libdir/pkgconfig/whitted.pc" bin/whitted "$libdir/libwhitted_oiio.so" \
          "$libdir/libwhitted_live.so" "$libdir/libwhitted_exr.so" "$libdir/libwhitted_tiff.so" "$libdir/libwhitted_jpeg.so"; do

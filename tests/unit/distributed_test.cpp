@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// whitted::render's tile source and sink (RenderOptions::next_tile, on_tile_done), and
+// whitted::render's tile source and sink (RenderJob::next_tile, on_tile_done), and
 // render_distributed over an in-process WorkExchange whose "ranks" are threads of this process:
 // the packing, sending and assembly of tiles give the one-process image bit for bit. The same
 // over MPI, with real ranks: tests/mpi (label mpi).
@@ -70,9 +70,9 @@ TEST(RenderTiles, ATileSourceInAnyOrderGivesTheSameImage) {
     for (const int samples : {1, 2}) {
         const Scene scene = test::scene_from(scene_text(samples));
         const Accelerator accelerator(scene, 2);
-        RenderOptions options;
+        RenderJob options;
         options.threads = 2;
-        const RenderResult whole = render(scene, accelerator, options);
+        const RenderedTiles whole = render(scene, accelerator, options);
         ASSERT_FALSE(whole.cancelled);
         ASSERT_GT(std::set<float>(whole.image.rgb.begin(), whole.image.rgb.end()).size(), 100u);
 
@@ -90,7 +90,7 @@ TEST(RenderTiles, ATileSourceInAnyOrderGivesTheSameImage) {
             done.insert(tile);
             EXPECT_EQ(counts.camera, render_tile_rect(scene.width, scene.height, tile).pixels() * samples * samples);
         };
-        const RenderResult reversed = render(scene, accelerator, options);
+        const RenderedTiles reversed = render(scene, accelerator, options);
         EXPECT_FALSE(reversed.cancelled);
         EXPECT_TRUE(same_pixels(reversed.image, whole.image)) << samples << " sample(s)";
         EXPECT_EQ(reversed.rays.total(), whole.rays.total());
@@ -103,9 +103,9 @@ TEST(RenderTiles, ATileSourceInAnyOrderGivesTheSameImage) {
 TEST(RenderTiles, OnlyTheTilesGivenAreRendered) {
     const Scene scene = test::scene_from(scene_text(1));
     const Accelerator accelerator(scene, 1);
-    RenderOptions options;
+    RenderJob options;
     options.threads = 2;
-    const RenderResult whole = render(scene, accelerator, options);
+    const RenderedTiles whole = render(scene, accelerator, options);
     std::mutex mutex;
     size_t next = 0;
     options.next_tile = [&](size_t& tile) {
@@ -115,7 +115,7 @@ TEST(RenderTiles, OnlyTheTilesGivenAreRendered) {
         next += 2;
         return true;
     };
-    const RenderResult part = render(scene, accelerator, options);
+    const RenderedTiles part = render(scene, accelerator, options);
     EXPECT_FALSE(part.cancelled);
     for (size_t t = 0; t < 6; ++t) {
         const TileRect rect = render_tile_rect(scene.width, scene.height, t);
@@ -187,13 +187,13 @@ TEST(RenderDistributed, TwoRanksInOneProcessGiveTheOneProcessImage) {
     for (const int samples : {1, 3}) {
         const Scene scene = test::scene_from(scene_text(samples));
         const Accelerator accelerator(scene, 2);
-        RenderOptions options;
+        RenderJob options;
         options.threads = 1;
-        const RenderResult whole = render(scene, accelerator, options);
+        const RenderedTiles whole = render(scene, accelerator, options);
 
         SharedQueue queue;
         InProcessExchange rank0(queue, 0), rank1(queue, 1);
-        RenderResult root, other;
+        RenderedTiles root, other;
         std::thread second([&] { other = render_distributed(scene, accelerator, options, rank1); });
         root = render_distributed(scene, accelerator, options, rank0);
         second.join();
@@ -207,7 +207,7 @@ TEST(RenderDistributed, TwoRanksInOneProcessGiveTheOneProcessImage) {
 TEST(RenderDistributed, RenderLayersAreRefused) {
     const Scene scene = test::scene_from(scene_text(1));
     const Accelerator accelerator(scene, 1);
-    RenderOptions options;
+    RenderJob options;
     options.layers = parse_layers({"diffuse"});
     SharedQueue queue;
     InProcessExchange rank0(queue, 0);

@@ -123,15 +123,15 @@ TEST_P(LayersPerSamples, WatchingChangesNothingAndTheLayersAddUp) {
 TEST_P(LayersPerSamples, BeautyIsTheFloatSumOfTheLayersForAnyThreadCount) {
     const Scene scene = test::scene_from(scene_text(GetParam()));
     const Accelerator accelerator(scene, 2);
-    RenderOptions options;
+    RenderJob options;
     options.threads = 1;
     options.layers = LayerSet::all();
-    const RenderResult one = render(scene, accelerator, options);
+    const RenderedTiles one = render(scene, accelerator, options);
     ASSERT_EQ(one.image.layers.size(), 6u + 2u + 8u);  // ambient..background, light1..2, N..hits
     options.threads = 3;
-    const RenderResult three = render(scene, accelerator, options);
+    const RenderedTiles three = render(scene, accelerator, options);
     options.layers = LayerSet();
-    const RenderResult plain = render(scene, accelerator, options);
+    const RenderedTiles plain = render(scene, accelerator, options);
     ASSERT_TRUE(plain.image.layers.empty());
     const size_t pixels = size_t(scene.width) * scene.height;
     for (size_t l = 0; l < one.image.layers.size(); ++l)
@@ -156,11 +156,11 @@ TEST_P(LayersPerSamples, BeautyIsTheFloatSumOfTheLayersForAnyThreadCount) {
 TEST_P(LayersPerSamples, ExplainGivesEveryPixelOfTheRender) {
     const Scene scene = test::scene_from(scene_text(GetParam()));
     const Accelerator accelerator(scene, 2);
-    RenderOptions options;
+    RenderJob options;
     options.threads = 2;
-    const RenderResult plain = render(scene, accelerator, options);
+    const RenderedTiles plain = render(scene, accelerator, options);
     options.layers = LayerSet::all();
-    const RenderResult layered = render(scene, accelerator, options);
+    const RenderedTiles layered = render(scene, accelerator, options);
     for (int j = 0; j < scene.height; ++j)
         for (int i = 0; i < scene.width; ++i) {
             const PixelExplanation e = explain_pixel(scene, accelerator, i, j);
@@ -186,9 +186,9 @@ TEST(Layers, RefractedRaysFillTheTransmissionLayer) {
         "  - {type: sphere, center: [0, 0.6, 0], radius: 0.6, material: {ks: 0.3, p: 20, km: 0.1, kt: 0.8, ior: "
         "1.5}}\n");
     const Accelerator accelerator(scene, 2);
-    RenderOptions options;
+    RenderJob options;
     options.layers = LayerSet::all();
-    const RenderResult result = render(scene, accelerator, options);
+    const RenderedTiles result = render(scene, accelerator, options);
     ASSERT_EQ(result.image.layers[4].name, "transmission");
     const size_t pixels = size_t(scene.width) * scene.height;
     double transmitted = 0, mirrored = 0;

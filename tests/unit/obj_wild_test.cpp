@@ -340,9 +340,9 @@ TEST(ObjWild, RenderOfAConcaveFaceCoversItsArea) {
                           "objects: [{type: mesh, file: comb.obj, material: {ka: 1}}]"}),
         (directory.path() / "scene.yaml").string());
     const Accelerator accelerator(scene, 1);
-    RenderOptions options;
+    RenderJob options;
     options.threads = 2;
-    const RenderResult result = render(scene, accelerator, options);
+    const RenderedTiles result = render(scene, accelerator, options);
     int covered = 0;
     for (int j = 0; j < pixels; ++j)
         for (int i = 0; i < pixels; ++i) covered += result.image.pixel(i, j)[0] > 0;

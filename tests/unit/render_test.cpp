@@ -61,9 +61,9 @@ TEST_P(RenderPerSamples, ImageIsBitIdenticalForEveryBuildAndRenderThreadCount) {
     const int samples = GetParam();
     const Scene scene = test::scene_from(scene_text(samples));
     ASSERT_EQ(scene.samples, samples);
-    RenderOptions options;
+    RenderJob options;
     options.threads = 1;
-    RenderResult one;
+    RenderedTiles one;
     {
         const Accelerator first(scene, 1);
         one = render(scene, first, options);
@@ -80,7 +80,7 @@ TEST_P(RenderPerSamples, ImageIsBitIdenticalForEveryBuildAndRenderThreadCount) {
         for (const int threads : {1, 2, 3}) {
             if (build_threads == 1 && threads == 1) continue;
             options.threads = threads;
-            const RenderResult other = render(scene, accelerator, options);
+            const RenderedTiles other = render(scene, accelerator, options);
             EXPECT_TRUE(same_pixels(other.image, one.image))
                 << "BVH built on " << build_threads << " thread(s), rendered on " << threads;
             EXPECT_EQ(other.rays.total(), one.rays.total()) << build_threads << "/" << threads << " threads";
@@ -95,9 +95,9 @@ TEST_P(RenderPerSamples, EveryPixelHoldsTheRenderPixelValue) {
     const int samples = GetParam();
     const Scene scene = test::scene_from(scene_text(samples));
     const Accelerator accelerator(scene, 2);
-    RenderOptions options;
+    RenderJob options;
     options.threads = 2;
-    const RenderResult result = render(scene, accelerator, options);
+    const RenderedTiles result = render(scene, accelerator, options);
     const LectureShading shading(scene, accelerator);
     int differing = 0;
     for (int j = 0; j < scene.height; ++j)
@@ -119,12 +119,12 @@ TEST_P(RenderPerSamples, ACropWindowIsTheWholeRendersPixels) {
     const int samples = GetParam();
     const Scene scene = test::scene_from(scene_text(samples));
     const Accelerator accelerator(scene, 2);
-    RenderOptions options;
+    RenderJob options;
     options.threads = 2;
-    const RenderResult whole = render(scene, accelerator, options);
+    const RenderedTiles whole = render(scene, accelerator, options);
     for (const TileRect window : {TileRect{20, 35, 5, 15}, TileRect{1, 6, 1, 6}, TileRect{0, 41, 0, 23}}) {
         options.crop = window;
-        const RenderResult cropped = render(scene, accelerator, options);
+        const RenderedTiles cropped = render(scene, accelerator, options);
         const Image part = crop_image(cropped.image, window);
         ASSERT_EQ(part.width, window.x_end - window.x_begin);
         ASSERT_EQ(part.height, window.y_end - window.y_begin);

@@ -4,13 +4,14 @@
 // Whitted's public C++ API (docs/library.md): load or build a scene, render it, write the image
 // through the colour pipeline, convert it to POV-Ray SDL, check it against POV-Ray.
 //
-// This header and the ones it includes (whitted/image.h, whitted/version.h) are all a caller
+// This header and the ones it includes (whitted/image.h, whitted/progress.h, whitted/version.h) are all a caller
 // needs: standard C++20 only, no Embree, TBB, YAML or OpenColorIO types. Every function that can
 // fail on the caller's input returns an Expected: the value, or an Error saying what is wrong and
 // where (FILE:LINE:COL). Nothing here throws for bad input; only misuse (value() of an error)
 // throws.
 
 #include "whitted/image.h"
+#include "whitted/progress.h"
 #include "whitted/version.h"
 
 #include <atomic>
@@ -228,13 +229,6 @@ private:
     std::unique_ptr<Impl> m_impl;
 };
 
-/// How far a render is.
-struct Progress {
-    size_t tiles_done = 0, tiles_total = 0;
-    uint64_t rays = 0;
-    double seconds = 0;
-};
-
 /// A rectangle of pixels: its top-left corner (column, row from the top-left, 0-based) and size.
 struct PixelWindow {
     int x = 0, y = 0, width = 0, height = 0;
@@ -308,12 +302,31 @@ struct WriteOptions {
 /// file appears complete or not at all.
 WHITTED_API Expected<void> write_image(const Image& image, const std::string& path, const WriteOptions& options = {});
 
+/// How explain() writes the pixel's equation.
+enum class ExplainFormat {
+    text,     ///< every sample, segment, light and term with its numbers (`whitted explain`)
+    summary,  ///< a dozen lines: the first hit, each term averaged over the samples, the pixel (`--summary`)
+    json,     ///< docs/explain.schema.json (`--json`)
+};
+
+struct ExplainOptions {
+    ExplainFormat format = ExplainFormat::json;
+    int threads = 0;  ///< build threads for the BVH, if no render has built it yet (0 = all cores)
+};
+
+/// `whitted explain SCENE --pixel X,Y`: every term of pixel (x, y)'s equation (column, row from
+/// the top-left, 0-based), traced as the render traces it (the same camera ray packets, so the
+/// same numbers bit for bit), as the text `whitted explain` prints: ending in a newline, the scene
+/// named by its path(). A pixel outside the image is an Error (bad_input).
+WHITTED_API Expected<std::string> explain(const Scene& scene, int x, int y, const ExplainOptions& options = {});
+
 /// The scene as POV-Ray 3.7 SDL (docs/pov-model.md), as `whitted convert s.yaml s.pov` writes it:
 /// the description it was loaded from (or built with), whatever its file says now.
 WHITTED_API Expected<std::string> to_povray(const Scene& scene);
 /// Writes `pov_path` and the .ini beside it that renders it like Whitted; returns the .ini path.
 WHITTED_API Expected<std::string> write_povray(const Scene& scene, const std::string& pov_path);
 
+/// How `whitted check` runs (its options of the same names).
 struct CheckOptions {
     int threads = 0;
     double tolerance_codes = 2;   ///< per channel, in 16-bit codes (1/65535)
@@ -321,8 +334,27 @@ struct CheckOptions {
     double max_error_codes = 64;  ///< hard cap, 16-bit codes
     std::string report_dir;       ///< empty: no report
     bool quiet = true;            ///< false: print the figures as `whitted check` does
+    /// Render layers (docs/layers.md), as `check --layers`: Whitted renders with them, and its
+    /// beauty, then the float sum of the colour layers, is compared. Empty: none.
+    std::vector<std::string> layers;
+    /// `check --terms`: the scene with only ambient, only diffuse, only specular, and each light
+    /// alone (several lights), each checked against POV-Ray (a report per term in
+    /// report_dir/TERM); the result passes when every term does, and its verdict names the terms
+    /// that disagree.
+    bool terms = false;
+    /// `check --povray-image`: compare with this stored POV-Ray 16-bit PNG of the converted scene
+    /// (samples·W × samples·H) instead of running POV-Ray; empty: run POV-Ray.
+    std::string povray_image;
+    double exposure = 1;  ///< with povray_image: the exposure it was made at (a power of two ≤ 1)
+    /// Set to true (from any thread, or a signal handler) to stop: POV-Ray is ended, the
+    /// temporary files are removed, and check() returns an Error of kind cancelled.
+    const std::atomic<bool>* cancel = nullptr;
+    /// When given, check() sets it to false before it creates its first file or directory: while
+    /// it is true a signal handler may end the process at once, as there is nothing to clean up.
+    std::atomic<bool>* nothing_created_yet = nullptr;
 };
 
+/// What check() found.
 struct CheckResult {
     bool passed = false;
     double fraction_within = 0;  ///< share of pixels within tolerance
@@ -334,7 +366,51 @@ struct CheckResult {
 
 /// `whitted check`: renders the scene file with Whitted and, converted, with POV-Ray 3.7 (found
 /// as $WHITTED_POVRAY or `povray`) and compares them pixel by pixel (docs/validation.md). Loads
-/// the OpenImageIO plug-in. A failed comparison is a result, not an Error.
+/// the OpenImageIO plug-in. Prints the verdict line (and, unless quiet, the figures) on standard
+/// output, as `whitted check` does. A failed comparison is a result, not an Error; a cancelled
+/// check is an Error of kind cancelled.
 WHITTED_API Expected<CheckResult> check(const std::string& scene_path, const CheckOptions& options = {});
+
+/// The pass rule of `whitted compare` and `whitted check` (docs/validation.md), in 16-bit codes
+/// (1/65535 of the linear range): at least `min_fraction` of the pixels have every channel within
+/// `tolerance_codes`, no channel of any pixel is off by more than `max_error_codes`, no value of
+/// either image is NaN or ±Inf, and both images have the same size and channel count.
+struct PassRule {
+    double tolerance_codes = 2;
+    double min_fraction = 0.999;
+    double max_error_codes = 64;
+};
+
+/// What compare_image_files() found.
+struct Comparison {
+    bool passed = false;
+    /// What each file was read as ("linear Rec.709 (EXR)", "sRGB display codes ..."); empty
+    /// when the images could not be compared at all (their sizes or channels differ).
+    std::string first_meaning, second_meaning;
+    double fraction_within = 0;         ///< share of pixels within tolerance
+    double max_error_codes = 0;         ///< largest error of any channel, 16-bit codes (infinity with NaN/Inf)
+    double rms_error = 0;               ///< linear units
+    std::vector<std::string> failures;  ///< the rules broken, e.g. "cap (max 1000.0 codes > 64)"
+    std::string verdict;                ///< "PASS A vs B: ..." or "FAIL A vs B: ...", as `whitted compare` prints
+};
+
+/// `whitted compare A B`: the two image files (EXR, PNG, JPEG, TIFF, ...), each first turned into
+/// linear Rec.709 from its colour metadata, compared channel by channel under `rule`. With
+/// `clip`, both are clipped to [0, 1] first (a float EXR against a PNG, which clips); NaN and Inf
+/// values are counted before that. Loads the OpenImageIO plug-in. Images that differ are a
+/// result, not an Error; a file that cannot be read or whose colour is not known is an Error
+/// (bad_input).
+WHITTED_API Expected<Comparison> compare_image_files(const std::string& first, const std::string& second,
+                                                     const PassRule& rule = {}, bool clip = false);
+
+/// `whitted colour --list`: each display and view of the OpenColorIO config at `config_path`
+/// (empty: $OCIO, else the built-in config), the colour space it writes and what that means; the
+/// text `whitted colour --list` prints.
+WHITTED_API Expected<std::string> describe_colour_config(const std::string& config_path = {});
+
+/// `whitted colour --write-config`: writes the built-in OpenColorIO config (the one write_image
+/// uses without $OCIO) to `path`, for other programs (oiiotool, Nuke, Blender). The file appears
+/// complete or not at all; a symbolic link is not written through.
+WHITTED_API Expected<void> write_colour_config(const std::string& path);
 
 }  // namespace whitted::api

@@ -51,8 +51,8 @@ struct TileHeader {
 
 }  // namespace
 
-RenderResult render_distributed(const Scene& scene, const Accelerator& accelerator, const RenderOptions& options,
-                                WorkExchange& exchange) {
+RenderedTiles render_distributed(const Scene& scene, const Accelerator& accelerator, const RenderJob& options,
+                                 WorkExchange& exchange) {
     if (!options.layers.empty())
         throw std::invalid_argument(
             "render layers are not available in a distributed (MPI) render yet; render them in one process");
@@ -93,7 +93,7 @@ RenderResult render_distributed(const Scene& scene, const Accelerator& accelerat
     exchange.begin(item_count, receive, options.cancel);
 
     const auto remote_rays = [&] { return remote_camera.load() + remote_shadow.load() + remote_reflected.load(); };
-    const auto report = [&](RenderProgress progress) {
+    const auto report = [&](api::Progress progress) {
         progress.tiles_done = exchange.items_done();
         progress.tiles_total = item_count;
         progress.rays += remote_rays();
@@ -101,7 +101,7 @@ RenderResult render_distributed(const Scene& scene, const Accelerator& accelerat
         options.on_progress(progress);
     };
 
-    RenderOptions local = options;
+    RenderJob local = options;
     local.crop.reset();  // the items are the window's tiles already
     local.next_tile = [&](size_t& tile) {
         size_t item;
@@ -128,7 +128,7 @@ RenderResult render_distributed(const Scene& scene, const Accelerator& accelerat
     local.on_progress = nullptr;
     if (root && options.on_progress) local.on_progress = report;
 
-    RenderResult result = render(scene, accelerator, local);
+    RenderedTiles result = render(scene, accelerator, local);
     uint64_t local_rays = result.rays.total();
     const bool complete = exchange.end([&] {
         if (root && options.on_progress) report({0, 0, local_rays, 0});

@@ -29,7 +29,7 @@ std::unique_ptr<WorkExchange> open_mpi_exchange();
 /// render() with the tiles handed out by `exchange`: on rank 0 the result holds the whole
 /// image (and the rays of all ranks); on the others only the tiles they rendered. Render
 /// layers are refused (std::invalid_argument): they are not sent between ranks yet.
-RenderResult render_distributed(const Scene& scene, const Accelerator& accelerator, const RenderOptions& options,
-                                WorkExchange& exchange);
+RenderedTiles render_distributed(const Scene& scene, const Accelerator& accelerator, const RenderJob& options,
+                                 WorkExchange& exchange);
 
 }  // namespace whitted

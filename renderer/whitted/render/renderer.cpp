@@ -253,7 +253,7 @@ Image crop_image(const Image& image, const TileRect& window) {
     return out;
 }
 
-RenderResult render(const Scene& scene, const Accelerator& accelerator, const RenderOptions& options) {
+RenderedTiles render(const Scene& scene, const Accelerator& accelerator, const RenderJob& options) {
     using clock = std::chrono::steady_clock;
     const auto start = clock::now();
     // The tiles to render: every one, or those the crop window overlaps (a tile source, when
@@ -264,7 +264,7 @@ RenderResult render(const Scene& scene, const Accelerator& accelerator, const Re
         options.crop && !options.next_tile ? cropped_tiles.size() : render_tile_count(scene.width, scene.height);
     const auto tile_number = [&](size_t i) { return options.crop && !options.next_tile ? cropped_tiles[i] : i; };
 
-    RenderResult result;
+    RenderedTiles result;
     result.image.width = scene.width;
     result.image.height = scene.height;
     result.image.rgb.assign(size_t(scene.width) * scene.height * 3, 0.0f);
@@ -282,9 +282,9 @@ RenderResult render(const Scene& scene, const Accelerator& accelerator, const Re
         reporter = std::thread([&] {
             std::unique_lock lock(mutex);
             while (!finished_signal.wait_for(lock, std::chrono::milliseconds(200), [&] { return finished; })) {
-                const RenderProgress progress{tiles_done.load(), tile_count,
-                                              camera_rays.load() + shadow_rays.load() + reflected_rays.load(),
-                                              std::chrono::duration<double>(clock::now() - start).count()};
+                const api::Progress progress{tiles_done.load(), tile_count,
+                                             camera_rays.load() + shadow_rays.load() + reflected_rays.load(),
+                                             std::chrono::duration<double>(clock::now() - start).count()};
                 options.on_progress(progress);
             }
         });

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "whitted/image.h"
+#include "whitted/progress.h"
 #include "whitted/render/accelerator.h"
 #include "whitted/render/layers.h"
 #include "whitted/render/shading.h"
@@ -16,12 +17,6 @@ namespace whitted {
 
 // Image, the film every part shares, is public: whitted/image.h.
 
-struct RenderProgress {
-    size_t tiles_done = 0, tiles_total = 0;
-    uint64_t rays = 0;
-    double seconds = 0;
-};
-
 /// A rectangle of pixels, [x_begin, x_end) × [y_begin, y_end).
 struct TileRect {
     int x_begin, x_end, y_begin, y_end;
@@ -31,7 +26,10 @@ struct TileRect {
     }
 };
 
-struct RenderOptions {
+/// What the tile renderer is asked to do: the library's side of api::RenderOptions (which the
+/// API turns into this), with the crop as tiles, the layers parsed, and the hooks only the
+/// library itself uses (where tiles come from and go to, for a distributed render).
+struct RenderJob {
     int threads = 0;  ///< 0 = all cores
     /// Render only the tiles that overlap this window of the image (`whitted render --crop`):
     /// the image is still the whole image, black outside those tiles; crop_image() cuts it out.
@@ -43,7 +41,7 @@ struct RenderOptions {
     /// Set from outside (a signal handler) to stop early; checked before every tile.
     const std::atomic<bool>* cancel = nullptr;
     /// Called from one thread a few times a second while rendering (e.g. a progress bar).
-    std::function<void(const RenderProgress&)> on_progress;
+    std::function<void(const api::Progress&)> on_progress;
     /// Where the tiles come from (a distributed render: docs/distributed.md). Unset: every tile,
     /// spread over the threads. Set: each worker thread asks it for a tile index (row-major,
     /// tile_rect) until it returns false, so this process renders only the tiles it is given;
@@ -59,7 +57,9 @@ constexpr int render_tile_size = 32;
 size_t render_tile_count(int width, int height);
 TileRect render_tile_rect(int width, int height, size_t tile);
 
-struct RenderResult {
+/// What render() gives back: the whole image (black outside the tiles rendered), from which
+/// the API makes an api::RenderResult (cut to the crop window, the rays as RenderStats).
+struct RenderedTiles {
     Image image;
     RayCounts rays;
     double seconds = 0;
@@ -73,7 +73,7 @@ Image crop_image(const Image& image, const TileRect& window);
 
 /// Renders the scene in tiles on all (or `threads`) cores. Every pixel depends only on the
 /// scene, never on the order tiles finish, so the image is bit-identical for any thread count.
-RenderResult render(const Scene& scene, const Accelerator& accelerator, const RenderOptions& options);
+RenderedTiles render(const Scene& scene, const Accelerator& accelerator, const RenderJob& options);
 
 /// One pixel, all its samples averaged (box filter).
 Color render_pixel(const Scene& scene, const LectureShading& shading, int i, int j, RayCounts& counts);
