@@ -538,6 +538,7 @@ Expected<CheckResult> check(const std::string& scene_path, const CheckOptions& o
         internal.rule.max_error = options.max_error_codes / 65535.0;
         internal.report_dir = options.report_dir;
         internal.quiet = options.quiet;
+        internal.cancel = options.cancel;
         // `check` lives in the OpenImageIO plug-in (whitted/core/plugin.h), like the program's.
         // Its errors come back as values: exceptions do not cross into the plug-in's own copy
         // of the libraries. 0: done, 2: bad input, 1: failure.
@@ -548,7 +549,9 @@ Expected<CheckResult> check(const std::string& scene_path, const CheckOptions& o
         std::string verdict;
         Error error;
         if (const int status = run_check(scene_path, internal, result, verdict, error); status != 0) {
-            error.kind = status == 2 ? Error::Kind::bad_input : Error::Kind::failure;
+            error.kind = options.cancel && options.cancel->load() ? Error::Kind::cancelled
+                         : status == 2                            ? Error::Kind::bad_input
+                                                                  : Error::Kind::failure;
             return error;
         }
         CheckResult out;

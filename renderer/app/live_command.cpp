@@ -446,6 +446,8 @@ int run_live(const LiveArguments& args) {
             send_error(response, 422, e.what());
         }
     });
+    // Set by a stop signal: a running check ends POV-Ray and returns at once.
+    std::atomic<bool> stopping{false};
     // One render (or explain, or check) at a time: two at once would only share the two cores
     // and both be late.
     std::mutex render_mutex;
@@ -560,6 +562,7 @@ int run_live(const LiveArguments& args) {
         api::CheckOptions options;
         options.threads = args.threads;
         options.report_dir = (dir / "report").string();
+        options.cancel = &stopping;
         const api::Expected<api::CheckResult> result = api::check(file, options);
         if (!result) throw std::runtime_error(result.error().what());
         // The verdict names the file checked: the edited scene, not its temporary copy.
@@ -605,6 +608,7 @@ int run_live(const LiveArguments& args) {
             const int signal = sigtimedwait(&stop_signals, nullptr, &poll);
             if (signal > 0) {
                 stop_signal.store(signal);
+                stopping.store(true);
                 break;
             }
         }

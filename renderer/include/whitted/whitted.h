@@ -321,6 +321,9 @@ struct CheckOptions {
     double max_error_codes = 64;  ///< hard cap, 16-bit codes
     std::string report_dir;       ///< empty: no report
     bool quiet = true;            ///< false: print the figures as `whitted check` does
+    /// Set (from another thread) to stop: POV-Ray's process group is ended, the check's
+    /// temporary files removed, and check returns an Error of kind cancelled.
+    const std::atomic<bool>* cancel = nullptr;
 };
 
 struct CheckResult {
