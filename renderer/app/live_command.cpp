@@ -346,7 +346,9 @@ std::vector<float> data_view_colours(const ImageLayer& layer) {
 }
 
 /// The render at `level` "coarse" (a quarter of the width and height, one sample per pixel: the
-/// first image while the slider moves) or "full" (the scene's own settings), as PNG through the
+/// first image while the slider moves), "preview" (the full width and height, one sample per
+/// pixel: a quarter of the work of the usual 2×2 samples) or "full" (the scene's own settings,
+/// the image that equals `whitted render`'s), as PNG through the
 /// default display transform (as `whitted render -o x.png`) or linear EXR (as `-o x.exr`). A
 /// `view` other than "beauty" is that render layer, rendered as `whitted render --layers` does:
 /// a colour layer written as the image's R, G, B; a data layer as its colours
@@ -357,17 +359,17 @@ struct Rendered {
     double render_seconds = 0, encode_seconds = 0;
 };
 
-Rendered render_image(SceneDescription description, const std::string& view, bool coarse, int threads,
+Rendered render_image(SceneDescription description, const std::string& view, const std::string& level, int threads,
                       const std::filesystem::path& temp_file) {
     auto impl = std::make_unique<api::Scene::Impl>();
     impl->description = std::move(description);
     const std::string layer = layer_for_view(view, impl->description.lights.size());
-    if (coarse) {
-        ImageDescription& image = impl->description.image;
+    ImageDescription& image = impl->description.image;
+    if (level == "coarse") {
         image.width.value = std::max<int64_t>(1, image.width.value / 4);
         image.height.value = std::max<int64_t>(1, image.height.value / 4);
-        image.samples.value = 1;
     }
+    if (level != "full") image.samples.value = 1;
     impl->scene = validate_scene(impl->description);
     const api::Scene scene(std::move(impl));
     api::RenderOptions options;
@@ -568,14 +570,14 @@ int run_live(const LiveArguments& args) {
 
     post("/render", [&](const json& body, const LiveState::Snapshot& snapshot, httplib::Response& response) {
         const std::string level = string_member(body, "level", "full"), format = string_member(body, "format", "png");
-        if ((level != "full" && level != "coarse") || (format != "png" && format != "exr"))
-            throw BadRequest("level must be full or coarse, format png or exr");
+        if ((level != "full" && level != "preview" && level != "coarse") || (format != "png" && format != "exr"))
+            throw BadRequest("level must be full, preview or coarse, format png or exr");
         const std::string view = string_member(body, "view", "beauty");
         std::lock_guard lock(render_mutex);
         const std::filesystem::path file = temp_dir / ("render-" + std::to_string(++render_count) + "." + format);
         const auto start = std::chrono::steady_clock::now();
         const Rendered rendered = render_image(edited_description(snapshot.text, state.path(), values_of(body)), view,
-                                               level == "coarse", args.threads, file);
+                                               level, args.threads, file);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         response.set_header("X-Whitted-Version", std::to_string(snapshot.version));
         response.set_header("X-Whitted-Render-Ms", std::to_string(int(rendered.render_seconds * 1000 + 0.5)));

@@ -131,8 +131,9 @@ def main():
                     ("served-diffuse.png", {"format": "png", "view": "diffuse"}),
                     ("served-N.png", {"format": "png", "view": "N"})]
         requests += [(f"served-{layer}.exr", {"format": "exr", "view": layer}) for layer in DATA_LAYERS]
+        requests += [("served-preview.exr", {"format": "exr", "level": "preview"})]
         for name, body in requests:
-            code, data = post(port, "/render", dict(body, level="full", values=values))
+            code, data = post(port, "/render", dict({"level": "full", "values": values}, **body))
             check(code == 200, f"POST /render {body}: {code}")
             open(os.path.join(work, name), "wb").write(data)
 
@@ -167,6 +168,17 @@ def main():
         r = subprocess.run([whitted, "render", edited, "-q", "-o", os.path.join(work, output)])
         if r.returncode != 0:
             fail(f"whitted render {edited} -o {output} exited {r.returncode}")
+    # The page's second image, full resolution at one sample per pixel: `whitted render` of the
+    # edited file with samples: 1.
+    document["image"]["samples"] = 1
+    with open(os.path.join(work, "edited-1.yaml"), "w") as f:
+        yaml.safe_dump(document, f, sort_keys=False)
+    r = subprocess.run([whitted, "render", os.path.join(work, "edited-1.yaml"), "-q", "-o",
+                        os.path.join(work, "edited-1.exr")])
+    preview, rendered_1 = pixels(os.path.join(work, "served-preview.exr")), pixels(os.path.join(work, "edited-1.exr"))
+    check(r.returncode == 0 and preview.shape == rendered_1.shape and np.array_equal(preview, rendered_1)
+          and not np.array_equal(preview, pixels(os.path.join(work, "edited.exr"))),
+          f"the preview level {preview.shape} equals `whitted render` with samples: 1 bit for bit (not the full image)")
     r = subprocess.run([whitted, "render", scene, "-q", "-o", os.path.join(work, "original.png")])
     if r.returncode != 0:
         fail(f"whitted render {scene} exited {r.returncode}")
