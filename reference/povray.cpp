@@ -107,8 +107,19 @@ class SpawnGroup {
 public:
     SpawnGroup() {
         ::posix_spawnattr_init(&m_attributes);
-        m_ready = ::posix_spawnattr_setflags(&m_attributes, POSIX_SPAWN_SETPGROUP) == 0 &&
-                  ::posix_spawnattr_setpgroup(&m_attributes, 0) == 0;
+        // No signal blocked or ignored: a caller that blocks SIGTERM for a thread of its own to
+        // take (`whitted live`) would pass the mask on, and POV-Ray would then not end at stop()'s
+        // SIGTERM but only at the SIGKILL 2 s later.
+        sigset_t none, stop_signals;
+        sigemptyset(&none);
+        sigemptyset(&stop_signals);
+        sigaddset(&stop_signals, SIGINT);
+        sigaddset(&stop_signals, SIGTERM);
+        m_ready = ::posix_spawnattr_setflags(
+                      &m_attributes, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF) == 0 &&
+                  ::posix_spawnattr_setpgroup(&m_attributes, 0) == 0 &&
+                  ::posix_spawnattr_setsigmask(&m_attributes, &none) == 0 &&
+                  ::posix_spawnattr_setsigdefault(&m_attributes, &stop_signals) == 0;
     }
     ~SpawnGroup() { ::posix_spawnattr_destroy(&m_attributes); }
     SpawnGroup(const SpawnGroup&) = delete;

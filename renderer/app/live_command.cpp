@@ -259,42 +259,116 @@ SceneDescription edited_description(const std::string& text, const std::string& 
 /// The colour render layers the page can show instead of the beauty (docs/layers.md): each is
 /// an RGB image; light<k> (1-based) comes from the `lights` layer.
 const char* const colour_layers[] = {"ambient", "diffuse", "specular", "mirror", "transmission", "background"};
+/// The data layers, shown through a mapping to colours (data_view_colours).
+const char* const data_layers[] = {"N", "Ng", "P", "Z", "albedo", "objectId", "materialId", "hits"};
+
+bool is_data_layer(const std::string& view) {
+    for (const char* layer : data_layers)
+        if (view == layer) return true;
+    return false;
+}
 
 /// The layer to ask the render for to show `view` ("beauty": none), or BadRequest.
 std::string layer_for_view(const std::string& view, size_t light_count) {
     if (view == "beauty") return "none";
     for (const char* layer : colour_layers)
         if (view == layer) return view;
+    if (is_data_layer(view)) return view;
     if (view.size() > 5 && view.compare(0, 5, "light") == 0 && view[5] != '0' &&
         view.find_first_not_of("0123456789", 5) == std::string::npos && view.size() < 10) {
         const long k = std::stol(view.substr(5));
         if (k >= 1 && size_t(k) <= light_count) return "lights";
     }
     throw BadRequest("view '" + view + "': expected beauty, ambient, diffuse, specular, mirror, transmission, " +
-                     "background or light1.." + "light" + std::to_string(light_count));
+                     "background, light1.." + "light" + std::to_string(light_count) +
+                     ", N, Ng, P, Z, albedo, objectId, materialId or hits");
+}
+
+/// A distinct colour for each id (0, nothing hit: black): hues a golden angle apart, so that
+/// neighbouring ids differ clearly.
+void id_colour(float id, float* rgb) {
+    if (id == 0) {
+        rgb[0] = rgb[1] = rgb[2] = 0;
+        return;
+    }
+    const double hue = std::fmod(double(id) * 0.618033988749895, 1.0) * 6;
+    const int sector = int(hue);
+    const float f = float(hue - sector), up = 0.25f + 0.7f * f, down = 0.95f - 0.7f * f;
+    const float table[6][3] = {{0.95f, up, 0.25f},   {down, 0.95f, 0.25f}, {0.25f, 0.95f, up},
+                               {0.25f, down, 0.95f}, {up, 0.25f, 0.95f},   {0.95f, 0.25f, down}};
+    for (int c = 0; c < 3; ++c) rgb[c] = table[sector % 6][c];
+}
+
+/// A data layer's values as colours to show (docs/live.md): N and Ng as 0.5 + 0.5·n; P each
+/// axis scaled to [0, 1] over the image's hits; Z as 1 at the nearest hit to 0.1 at the farthest;
+/// albedo as it is; objectId and materialId a colour per id; hits as hits / the image's most.
+/// Where the camera ray misses: black.
+std::vector<float> data_view_colours(const ImageLayer& layer) {
+    const size_t n = layer.channels.size(), pixels = layer.values.size() / n;
+    const std::vector<float>& v = layer.values;
+    std::vector<float> rgb(pixels * 3, 0.0f);
+    const auto missed_vector = [&](size_t i) { return v[3 * i] == 0 && v[3 * i + 1] == 0 && v[3 * i + 2] == 0; };
+    if (layer.name == "N" || layer.name == "Ng") {
+        for (size_t i = 0; i < pixels; ++i)
+            if (!missed_vector(i))
+                for (int c = 0; c < 3; ++c) rgb[3 * i + c] = 0.5f + 0.5f * v[3 * i + c];
+    } else if (layer.name == "P") {
+        float low[3] = {INFINITY, INFINITY, INFINITY}, high[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (size_t i = 0; i < pixels; ++i)
+            if (!missed_vector(i))
+                for (int c = 0; c < 3; ++c) {
+                    low[c] = std::min(low[c], v[3 * i + c]);
+                    high[c] = std::max(high[c], v[3 * i + c]);
+                }
+        for (size_t i = 0; i < pixels; ++i)
+            if (!missed_vector(i))
+                for (int c = 0; c < 3; ++c)
+                    rgb[3 * i + c] = high[c] > low[c] ? (v[3 * i + c] - low[c]) / (high[c] - low[c]) : 0.5f;
+    } else if (layer.name == "Z") {
+        float near = INFINITY, far = -INFINITY;
+        for (float z : v)
+            if (std::isfinite(z)) near = std::min(near, z), far = std::max(far, z);
+        for (size_t i = 0; i < pixels; ++i)
+            if (std::isfinite(v[i]))
+                rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] =
+                    far > near ? 0.1f + 0.9f * ((far - v[i]) / (far - near)) : 1.0f;
+    } else if (layer.name == "albedo") {
+        rgb = v;
+    } else if (layer.name == "objectId" || layer.name == "materialId") {
+        for (size_t i = 0; i < pixels; ++i) id_colour(v[i], &rgb[3 * i]);
+    } else {  // hits
+        float most = 0;
+        for (float h : v) most = std::max(most, h);
+        for (size_t i = 0; i < pixels; ++i) rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = most > 0 ? v[i] / most : 0;
+    }
+    return rgb;
 }
 
 /// The render at `level` "coarse" (a quarter of the width and height, one sample per pixel: the
-/// first image while the slider moves) or "full" (the scene's own settings), as PNG through the
+/// first image while the slider moves), "preview" (the full width and height, one sample per
+/// pixel: a quarter of the work of the usual 2×2 samples) or "full" (the scene's own settings,
+/// the image that equals `whitted render`'s), as PNG through the
 /// default display transform (as `whitted render -o x.png`) or linear EXR (as `-o x.exr`). A
-/// `view` other than "beauty" is that render layer, rendered as `whitted render --layers` does,
-/// written as the image's R, G, B.
+/// `view` other than "beauty" is that render layer, rendered as `whitted render --layers` does:
+/// a colour layer written as the image's R, G, B; a data layer as its colours
+/// (data_view_colours), which a PNG holds as they are (the display's Raw view: they are not
+/// light), and an EXR as its R, G, B with the layer's own channels beside them.
 struct Rendered {
     std::string bytes;
-    double render_seconds = 0;
+    double render_seconds = 0, encode_seconds = 0;
 };
 
-Rendered render_image(SceneDescription description, const std::string& view, bool coarse, int threads,
+Rendered render_image(SceneDescription description, const std::string& view, const std::string& level, int threads,
                       const std::filesystem::path& temp_file) {
     auto impl = std::make_unique<api::Scene::Impl>();
     impl->description = std::move(description);
     const std::string layer = layer_for_view(view, impl->description.lights.size());
-    if (coarse) {
-        ImageDescription& image = impl->description.image;
+    ImageDescription& image = impl->description.image;
+    if (level == "coarse") {
         image.width.value = std::max<int64_t>(1, image.width.value / 4);
         image.height.value = std::max<int64_t>(1, image.height.value / 4);
-        image.samples.value = 1;
     }
+    if (level != "full") image.samples.value = 1;
     impl->scene = validate_scene(impl->description);
     const api::Scene scene(std::move(impl));
     api::RenderOptions options;
@@ -303,18 +377,30 @@ Rendered render_image(SceneDescription description, const std::string& view, boo
     api::Expected<api::RenderResult> result = api::render(scene, options);
     if (!result) throw std::runtime_error(result.error().what());
     Image shown;
+    api::WriteOptions write;
+    const bool exr = temp_file.extension() == ".exr";
     if (view == "beauty") {
         shown = std::move(result->image);
         shown.layers.clear();
     } else {
         shown.width = result->image.width;
         shown.height = result->image.height;
-        for (ImageLayer& l : result->image.layers)
-            if (l.channels.size() == 3 && l.channels[0] == view + ".R") shown.rgb = std::move(l.values);
+        for (ImageLayer& l : result->image.layers) {
+            if (l.name != view) continue;
+            if (!is_data_layer(view)) {
+                shown.rgb = std::move(l.values);
+            } else {
+                shown.rgb = data_view_colours(l);
+                if (exr) shown.layers.push_back(std::move(l));
+                if (view != "albedo") write.view = "Raw";  // albedo is a colour, the others are not
+            }
+        }
         if (shown.rgb.size() != size_t(shown.width) * size_t(shown.height) * 3)
             throw std::runtime_error("the render has no layer " + view);
     }
-    if (const auto written = api::write_image(shown, temp_file.string(), {}); !written)
+    if (exr) write.view.clear();
+    const auto encode_start = std::chrono::steady_clock::now();
+    if (const auto written = api::write_image(shown, temp_file.string(), write); !written)
         throw std::runtime_error(written.error().what());
     Rendered rendered;
     {
@@ -323,6 +409,7 @@ Rendered render_image(SceneDescription description, const std::string& view, boo
         bytes << in.rdbuf();
         rendered.bytes = bytes.str();
     }
+    rendered.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - encode_start).count();
     std::error_code ignored;
     std::filesystem::remove(temp_file, ignored);
     rendered.render_seconds = result->stats.seconds;
@@ -445,6 +532,8 @@ int run_live(const LiveArguments& args) {
             send_error(response, 422, e.what());
         }
     });
+    // Set by a stop signal: a running check ends POV-Ray and returns at once.
+    std::atomic<bool> stopping{false};
     // One render (or explain, or check) at a time: two at once would only share the two cores
     // and both be late.
     std::mutex render_mutex;
@@ -480,17 +569,18 @@ int run_live(const LiveArguments& args) {
 
     post("/render", [&](const json& body, const LiveState::Snapshot& snapshot, httplib::Response& response) {
         const std::string level = string_member(body, "level", "full"), format = string_member(body, "format", "png");
-        if ((level != "full" && level != "coarse") || (format != "png" && format != "exr"))
-            throw BadRequest("level must be full or coarse, format png or exr");
+        if ((level != "full" && level != "preview" && level != "coarse") || (format != "png" && format != "exr"))
+            throw BadRequest("level must be full, preview or coarse, format png or exr");
         const std::string view = string_member(body, "view", "beauty");
         std::lock_guard lock(render_mutex);
         const std::filesystem::path file = temp_dir / ("render-" + std::to_string(++render_count) + "." + format);
         const auto start = std::chrono::steady_clock::now();
         const Rendered rendered = render_image(edited_description(snapshot.text, state.path(), values_of(body)), view,
-                                               level == "coarse", args.threads, file);
+                                               level, args.threads, file);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         response.set_header("X-Whitted-Version", std::to_string(snapshot.version));
         response.set_header("X-Whitted-Render-Ms", std::to_string(int(rendered.render_seconds * 1000 + 0.5)));
+        response.set_header("X-Whitted-Encode-Ms", std::to_string(int(rendered.encode_seconds * 1000 + 0.5)));
         response.set_header("X-Whitted-Total-Ms", std::to_string(int(seconds * 1000 + 0.5)));
         response.set_content(rendered.bytes, format == "exr" ? "image/x-exr" : "image/png");
     });
@@ -570,6 +660,7 @@ int run_live(const LiveArguments& args) {
         api::CheckOptions options;
         options.threads = args.threads;
         options.report_dir = (dir / "report").string();
+        options.cancel = &stopping;
         const api::Expected<api::CheckResult> result = api::check(file, options);
         if (!result) throw std::runtime_error(result.error().what());
         // The verdict names the file checked: the edited scene, not its temporary copy.
@@ -615,6 +706,7 @@ int run_live(const LiveArguments& args) {
             const int signal = sigtimedwait(&stop_signals, nullptr, &poll);
             if (signal > 0) {
                 stop_signal.store(signal);
+                stopping.store(true);
                 break;
             }
         }

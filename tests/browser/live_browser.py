@@ -10,7 +10,8 @@ runs the check against POV-Ray, writes a bad edit to the file and saves the erro
 shows. Here, without the page: the server's EXR of those values and the page's PNG must equal
 `whitted render` of the scene with the values written into the file, pixel for pixel (read with
 OpenImageIO), and so must the render of saved.yaml; the page's explain must be `whitted explain
---json`'s numbers, its diffuse layer `whitted render --layers diffuse`'s, its verdict `whitted
+--json`'s numbers, its diffuse layer `whitted render --layers diffuse`'s, its data views'
+channels `whitted render --layers N,...`'s, its verdict `whitted
 check`'s, all of saved.yaml; saving over a file without "overwrite" is refused; the page's error
 must be the message `whitted render` prints for the bad file; SIGTERM exits 143.
 
@@ -30,6 +31,7 @@ import OpenImageIO as oiio
 import yaml
 
 SCENE = "examples/lecture/05-blinn-phong-p10.yaml"
+DATA_LAYERS = ("N", "Ng", "P", "Z", "albedo", "objectId", "materialId", "hits")
 CHROMIUM = os.environ.get("WHITTED_CHROMIUM", "/usr/bin/chromium")
 problems = []
 
@@ -123,10 +125,15 @@ def main():
             fail("the page did not do what it should (above)")
         values = json.load(open(os.path.join(work, "values.json")))
 
-        # The server's linear image of the same values, as EXR; its diffuse layer, as EXR and PNG.
-        for name, body in (("served.exr", {"format": "exr"}), ("served-diffuse.exr", {"format": "exr", "view": "diffuse"}),
-                           ("served-diffuse.png", {"format": "png", "view": "diffuse"})):
-            code, data = post(port, "/render", dict(body, level="full", values=values))
+        # The server's linear image of the same values, as EXR; its diffuse layer, as EXR and PNG;
+        # the N view as PNG and each data layer's view as EXR.
+        requests = [("served.exr", {"format": "exr"}), ("served-diffuse.exr", {"format": "exr", "view": "diffuse"}),
+                    ("served-diffuse.png", {"format": "png", "view": "diffuse"}),
+                    ("served-N.png", {"format": "png", "view": "N"})]
+        requests += [(f"served-{layer}.exr", {"format": "exr", "view": layer}) for layer in DATA_LAYERS]
+        requests += [("served-preview.exr", {"format": "exr", "level": "preview"})]
+        for name, body in requests:
+            code, data = post(port, "/render", dict({"level": "full", "values": values}, **body))
             check(code == 200, f"POST /render {body}: {code}")
             open(os.path.join(work, name), "wb").write(data)
 
@@ -161,6 +168,17 @@ def main():
         r = subprocess.run([whitted, "render", edited, "-q", "-o", os.path.join(work, output)])
         if r.returncode != 0:
             fail(f"whitted render {edited} -o {output} exited {r.returncode}")
+    # The page's second image, full resolution at one sample per pixel: `whitted render` of the
+    # edited file with samples: 1.
+    document["image"]["samples"] = 1
+    with open(os.path.join(work, "edited-1.yaml"), "w") as f:
+        yaml.safe_dump(document, f, sort_keys=False)
+    r = subprocess.run([whitted, "render", os.path.join(work, "edited-1.yaml"), "-q", "-o",
+                        os.path.join(work, "edited-1.exr")])
+    preview, rendered_1 = pixels(os.path.join(work, "served-preview.exr")), pixels(os.path.join(work, "edited-1.exr"))
+    check(r.returncode == 0 and preview.shape == rendered_1.shape and np.array_equal(preview, rendered_1)
+          and not np.array_equal(preview, pixels(os.path.join(work, "edited.exr"))),
+          f"the preview level {preview.shape} equals `whitted render` with samples: 1 bit for bit (not the full image)")
     r = subprocess.run([whitted, "render", scene, "-q", "-o", os.path.join(work, "original.png")])
     if r.returncode != 0:
         fail(f"whitted render {scene} exited {r.returncode}")
@@ -214,6 +232,50 @@ def main():
           "the served diffuse layer equals `whitted render --layers diffuse`'s diffuse.R/G/B bit for bit")
     check(np.array_equal(pixels(os.path.join(work, "page-diffuse.png")), pixels(os.path.join(work, "served-diffuse.png"))),
           "the page showed the server's PNG of that layer")
+
+    # The data layers as views: each served EXR holds the layer's channels exactly as `whitted
+    # render --layers` writes them (bit for bit), beside the R, G, B the page shows of them.
+    r = subprocess.run([whitted, "render", saved, "-q", "--layers", ",".join(DATA_LAYERS), "-o",
+                        os.path.join(work, "data-layers.exr")])
+    check(r.returncode == 0, f"whitted render --layers {','.join(DATA_LAYERS)}: exit {r.returncode}")
+    rendered_data = oiio.ImageInput.open(os.path.join(work, "data-layers.exr"))
+    rendered_names = list(rendered_data.spec().channelnames)
+    rendered_all = np.asarray(rendered_data.read_image(0, 0, 0, len(rendered_names), oiio.FLOAT))
+    rendered_data.close()
+    shown_data = {}
+    for layer in DATA_LAYERS:
+        served = oiio.ImageInput.open(os.path.join(work, f"served-{layer}.exr"))
+        served_names = list(served.spec().channelnames)
+        served_all = np.asarray(served.read_image(0, 0, 0, len(served_names), oiio.FLOAT))
+        served.close()
+        wanted = [n for n in rendered_names if n == layer or n.startswith(layer + ".")]
+        same = bool(wanted) and all(n in served_names for n in wanted) and all(
+            np.array_equal(served_all[..., served_names.index(n)], rendered_all[..., rendered_names.index(n)],
+                           equal_nan=True) for n in wanted)
+        check(same and served_names[:3] == ["R", "G", "B"],
+              f"the served {layer} view holds {wanted} equal to `whitted render --layers {layer}`'s bit for bit")
+        shown_data[layer] = (served_all[..., :3], {n: rendered_all[..., rendered_names.index(n)] for n in wanted})
+    shown, raw = shown_data["N"]
+    n = np.stack([raw["N.X"], raw["N.Y"], raw["N.Z"]], axis=-1)
+    hit = np.any(n != 0, axis=-1)
+    mapped = np.where(hit[..., None], np.float32(0.5) + np.float32(0.5) * n, np.float32(0))
+    check(np.array_equal(shown, mapped) and hit.any() and not hit.all(),
+          "the N view shows 0.5 + 0.5·N where the ray hits, black where it misses")
+    shown, raw = shown_data["Z"]
+    z = raw["Z"]
+    finite = np.isfinite(z)
+    near, far = z[finite].min(), z[finite].max()
+    check(np.allclose(shown[..., 0][finite], 0.1 + 0.9 * (far - z[finite]) / (far - near), atol=1e-6)
+          and np.all(shown[~finite] == 0) and shown[..., 0][finite].max() == 1,
+          f"the Z view shows 1 at the nearest hit ({near:.4g}) down to 0.1 at the farthest ({far:.4g}), misses black")
+    shown, raw = shown_data["objectId"]
+    ids = raw["objectId"]
+    colours = {i: {tuple(c) for c in shown[ids == i]} for i in np.unique(ids)}
+    check(all(len(c) == 1 for c in colours.values()) and colours.get(0.0, {(0, 0, 0)}) == {(0, 0, 0)}
+          and len({next(iter(c)) for c in colours.values()}) == len(colours) > 1,
+          f"the objectId view shows one colour per id, a different one for each of {len(colours)} ids, black for 0")
+    check(np.array_equal(pixels(os.path.join(work, "page-N.png")), pixels(os.path.join(work, "served-N.png"))),
+          "the page showed the server's PNG of the N view")
 
     # check: the verdict the page showed is `whitted check`'s for the saved file.
     checked = json.load(open(os.path.join(work, "check.json")))["result"]

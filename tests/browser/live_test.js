@@ -4,7 +4,7 @@
 // the full image of the new value, saves what the page sent and shows (live_browser.py compares
 // it with `whitted render` of the edited file), then writes a bad edit to the scene file and
 // saves the error the page shows, then restores the file and waits for the image to come back.
-// Between these it clicks a pixel (explain), shows the diffuse layer, saves the edited scene (and
+// Between these it clicks a pixel (explain), shows the diffuse layer and the N data layer, saves the edited scene (and
 // declines, then confirms, overwriting it) and runs the check against POV-Ray.
 // usage: node live_test.js URL SCENE WORK_DIR SCREENSHOT_DIR CHROMIUM
 "use strict";
@@ -106,6 +106,14 @@ async function settled(page, timeout) {
     const diffuse = await shownPng(page);
     check(!diffuse.equals(after), "the diffuse layer's image differs from the beauty");
     fs.writeFileSync(path.join(work, "page-diffuse.png"), diffuse);
+    // A data layer as the view: the normals, as 0.5 + 0.5·n.
+    await page.selectOption("#layer", "N");
+    await page.waitForFunction(() => whittedLive.shownView === "N" && document.body.dataset.live === "ready",
+                               null, {timeout: 60000});
+    const normals = await shownPng(page);
+    check(!normals.equals(after) && !normals.equals(diffuse), "the N view's image differs from the beauty and diffuse");
+    fs.writeFileSync(path.join(work, "page-N.png"), normals);
+    await page.screenshot({path: path.join(shots, "live-normals.png")});
     await page.selectOption("#layer", "beauty");
     await page.waitForFunction(() => whittedLive.shownView === "beauty" && document.body.dataset.live === "ready",
                                null, {timeout: 60000});
