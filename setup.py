@@ -25,7 +25,7 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 ROOT = os.path.dirname(os.path.abspath(__file__))
-# The image writers built as plug-ins (renderer/whitted/output/format_plugins.h).
+# The image writers built as plug-ins (renderer/src/output/format_plugins.h).
 PLUGIN_FORMATS = ("exr", "tiff", "jpeg")
 BUILD = os.path.abspath(os.environ.get("WHITTED_PIP_BUILD_DIR") or os.path.join(ROOT, "build-pip"))
 CMAKE_BUILD = os.path.join(BUILD, "cmake")

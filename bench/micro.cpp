@@ -2,13 +2,13 @@
 // Micro-benchmarks of the hot kernels (Google Benchmark). Speed targets live here and in
 // scripts/bench, never in timed unit tests.
 
-#include "whitted/geometry/shapes.h"
-#include "whitted/render/accelerator.h"
-#include "whitted/render/camera.h"
-#include "whitted/render/renderer.h"
-#include "whitted/render/shading.h"
-#include "whitted/scene/description.h"
-#include "whitted/scene/scene.h"
+#include "geometry/shapes.h"
+#include "render/accelerator.h"
+#include "render/camera.h"
+#include "render/renderer.h"
+#include "render/shading.h"
+#include "scene/description.h"
+#include "scene/scene.h"
 
 #include <benchmark/benchmark.h>
 

@@ -5,10 +5,10 @@
 // pass, as `whitted render` reads a scene). Best of --runs, wall and CPU seconds.
 //   whitted_parse_bench [--runs N] [--parse-only] FILE...
 
-#include "whitted/scene/description.h"
-#include "whitted/scene/scene.h"
-#include "whitted/scene/text_checks.h"
-#include "whitted/scene/yaml_tree.h"
+#include "scene/description.h"
+#include "scene/scene.h"
+#include "scene/text_checks.h"
+#include "scene/yaml_tree.h"
 
 #include <cstdio>
 #include <cstdlib>

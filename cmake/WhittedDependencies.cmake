@@ -18,7 +18,7 @@ find_package(PNG REQUIRED)
 find_package(JPEG REQUIRED)
 find_package(TIFF REQUIRED)
 find_package(ZLIB REQUIRED)
-# The Cornell CS4620 course's XML scenes (renderer/whitted/scene/course_xml.cpp): expat reports
+# The Cornell CS4620 course's XML scenes (renderer/src/scene/course_xml.cpp): expat reports
 # the line and column of every element, which the error messages need.
 find_package(EXPAT REQUIRED)
 # cpp-httplib (libcpp-httplib-dev): the local web server of `whitted live` (docs/live.md). Debian

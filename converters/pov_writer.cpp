@@ -9,12 +9,12 @@
 
 #include "converters/pov_writer.h"
 
-#include "whitted/compat/povray/tie_order.h"
-#include "whitted/core/ray.h"
-#include "whitted/geometry/shapes.h"
-#include "whitted/output/atomic_files.h"
-#include "whitted/scene/scene.h"
-#include "whitted/scene/text_checks.h"
+#include "compat/povray/tie_order.h"
+#include "core/ray.h"
+#include "geometry/shapes.h"
+#include "output/atomic_files.h"
+#include "scene/scene.h"
+#include "scene/text_checks.h"
 
 #include <fmt/format.h>
 

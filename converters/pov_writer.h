@@ -7,7 +7,7 @@
 // has folded the transforms, resolved the materials and read the mesh files: the SDL holds the
 // numbers Whitted renders, and no file is read again here.
 
-#include "whitted/scene/description.h"
+#include "scene/description.h"
 
 #include <string>
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "converters/yaml_writer.h"
 
-#include "whitted/output/atomic_files.h"
+#include "output/atomic_files.h"
 
 #include <charconv>
 #include <filesystem>

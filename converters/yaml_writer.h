@@ -6,7 +6,7 @@
 // parses to the same description and renders the same pixels; `whitted convert course.xml
 // scene.yaml` uses it to turn a course scene into Whitted's own format.
 
-#include "whitted/scene/description.h"
+#include "scene/description.h"
 
 #include <string>
 

@@ -5,13 +5,13 @@
 #include "reference/check.h"
 
 #include "converters/pov_writer.h"
+#include "output/atomic_files.h"
 #include "reference/povray.h"
-#include "whitted/output/atomic_files.h"
-#include "whitted/render/accelerator.h"
-#include "whitted/render/renderer.h"
-#include "whitted/scene/description.h"
-#include "whitted/scene/scene.h"
-#include "whitted/scene/text_checks.h"
+#include "render/accelerator.h"
+#include "render/renderer.h"
+#include "scene/description.h"
+#include "scene/scene.h"
+#include "scene/text_checks.h"
 
 #include <fmt/format.h>
 

@@ -2,8 +2,8 @@
 #pragma once
 
 #include "compare.h"
-#include "whitted/scene/description.h"
-#include "whitted/scene/layer_names.h"
+#include "scene/description.h"
+#include "scene/layer_names.h"
 
 #include <atomic>
 #include <stdexcept>

@@ -5,7 +5,7 @@
 
 #include "reference/compare.h"
 
-#include "whitted/scene/description.h"
+#include "scene/description.h"
 
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>

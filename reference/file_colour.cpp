@@ -26,7 +26,7 @@ bool contains(const std::string& text, const char* part) {
     return text.find(part) != std::string::npos;
 }
 
-/// Whitted's own words (DisplayEncoding::description in whitted/output/color_management.cpp).
+/// Whitted's own words (DisplayEncoding::description in output/color_management.cpp).
 Encoding from_whitted(const std::string& text, const std::string& source) {
     Encoding e;
     e.source = source;

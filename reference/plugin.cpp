@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: MIT
-// The OpenImageIO plug-in (lib/libwhitted_oiio.so; why it is separate: whitted/core/plugin.h).
+// The OpenImageIO plug-in (lib/libwhitted_oiio.so; why it is separate: core/plugin.h).
 // Its entry points are looked up by name with dlsym; both sides are built together by the same
 // compiler, so they pass C++ types.
 
 #include "reference/check.h"
 #include "reference/file_colour.h"
-#include "whitted/scene/errors.h"
-#include "whitted/scene/source_location.h"
-#include "whitted/scene/text_checks.h"
+#include "scene/errors.h"
+#include "scene/source_location.h"
+#include "scene/text_checks.h"
 #include "whitted/whitted.h"
 
 #include <OpenImageIO/imageio.h>

@@ -5,8 +5,8 @@
 
 #include "reference/povray.h"
 
+#include "output/atomic_files.h"
 #include "reference/check.h"
-#include "whitted/output/atomic_files.h"
 
 #include <fcntl.h>
 #include <signal.h>

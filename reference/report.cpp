@@ -9,8 +9,8 @@
 
 #include "reference/check.h"
 
-#include "whitted/output/atomic_files.h"
-#include "whitted/output/image_output.h"
+#include "output/atomic_files.h"
+#include "output/image_output.h"
 
 #include "report_viewer_js.h"
 

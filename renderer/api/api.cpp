@@ -2,18 +2,18 @@
 // The public API (whitted/whitted.h) over the private libraries: every exception of theirs is
 // turned into an Error value here, with the location an InputError carries.
 
-#include "api/api_internal.h"
+#include "api_internal.h"
 #include "converters/pov_writer.h"
+#include "core/plugin.h"
+#include "output/atomic_files.h"
+#include "output/color_management.h"
+#include "output/image_output.h"
 #include "reference/check.h"
-#include "whitted/core/plugin.h"
-#include "whitted/output/atomic_files.h"
-#include "whitted/output/color_management.h"
-#include "whitted/output/image_output.h"
-#include "whitted/render/distributed.h"
-#include "whitted/render/layers.h"
-#include "whitted/render/renderer.h"
-#include "whitted/scene/errors.h"
-#include "whitted/scene/text_checks.h"
+#include "render/distributed.h"
+#include "render/layers.h"
+#include "render/renderer.h"
+#include "scene/errors.h"
+#include "scene/text_checks.h"
 
 #include <algorithm>
 #include <chrono>
@@ -40,7 +40,7 @@ Error plain_error(std::string message, Error::Kind kind) {
     return error;
 }
 
-/// Runs `work`, turning what it throws into an Error (whitted/scene/errors.h); `what` finishes "out of
+/// Runs `work`, turning what it throws into an Error (scene/errors.h); `what` finishes "out of
 /// memory while ...".
 template <class T, class Work>
 Expected<T> guarded(const std::string& what, Work&& work) {
@@ -539,7 +539,7 @@ Expected<CheckResult> check(const std::string& scene_path, const CheckOptions& o
         internal.exposure = options.exposure;
         internal.cancel = options.cancel;
         internal.exit_at_once = options.nothing_created_yet;
-        // `check` lives in the OpenImageIO plug-in (whitted/core/plugin.h). Its errors come back
+        // `check` lives in the OpenImageIO plug-in (core/plugin.h). Its errors come back
         // as values: exceptions do not cross into the plug-in's own copy of the libraries.
         using RunCheck = bool (*)(const std::string&, const reference::CheckRun&, reference::CheckRecord&,
                                   std::vector<std::string>&, std::string&, Error&);

@@ -6,11 +6,11 @@
 // `whitted` program's `live`, which renders a description it edits, and `render` under MPI)
 // include this; the public headers never do.
 
-#include "whitted/output/image_output.h"
-#include "whitted/render/accelerator.h"
-#include "whitted/render/work_exchange.h"
-#include "whitted/scene/description.h"
-#include "whitted/scene/scene.h"
+#include "output/image_output.h"
+#include "render/accelerator.h"
+#include "render/work_exchange.h"
+#include "scene/description.h"
+#include "scene/scene.h"
 #include "whitted/whitted.h"
 
 #include <memory>

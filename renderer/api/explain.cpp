@@ -2,11 +2,11 @@
 // api::explain (whitted/whitted.h): one pixel's equation as `whitted explain` prints it, term by
 // term as text, in a dozen lines, or as JSON (docs/explain.schema.json).
 
-#include "whitted/render/explain.h"
-#include "api/api_internal.h"
-#include "whitted/scene/errors.h"
-#include "whitted/scene/source_location.h"
-#include "whitted/scene/text_checks.h"
+#include "render/explain.h"
+#include "api_internal.h"
+#include "scene/errors.h"
+#include "scene/source_location.h"
+#include "scene/text_checks.h"
 
 #include <fmt/format.h>
 #include <fmt/printf.h>

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "explain_command.h"
 
-#include "whitted/scene/errors.h"
+#include "scene/errors.h"
 #include "whitted/whitted.h"
 
 #include <fmt/format.h>

@@ -10,9 +10,9 @@
 #include "api/api_internal.h"
 #include "converters/yaml_writer.h"
 #include "live_page_html.h"
-#include "whitted/scene/description.h"
-#include "whitted/scene/errors.h"
-#include "whitted/scene/scene.h"
+#include "scene/description.h"
+#include "scene/errors.h"
+#include "scene/scene.h"
 #include "whitted/whitted.h"
 
 #include <httplib.h>

@@ -4,7 +4,7 @@
 // about as much start-up as OpenColorIO does (docs/performance.md, "Start-up").
 #include "live_command.h"
 
-#include "whitted/core/plugin.h"
+#include "core/plugin.h"
 
 #include <cstdio>
 #include <stdexcept>

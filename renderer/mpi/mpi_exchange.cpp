@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// lib/libwhitted_mpi.so: the WorkExchange of whitted/render/work_exchange.h over MPI. The only
+// lib/libwhitted_mpi.so: the WorkExchange of render/work_exchange.h over MPI. The only
 // code that links libmpi; `whitted` loads it when it finds itself started by mpirun or srun.
 //
 // Rank 0 holds the queue: a counter over items 0..count−1. Its own worker threads take one item
@@ -12,7 +12,7 @@
 // On every rank one service thread does all the MPI calls (the worker threads only touch
 // queues under a mutex), so MPI_THREAD_SERIALIZED is enough.
 
-#include "whitted/render/work_exchange.h"
+#include "render/work_exchange.h"
 
 #include <mpi.h>
 

@@ -5,7 +5,7 @@
 // reading the file as three runs of lines at once must give the same mesh or the same error.
 
 #include "fuzz_support.h"
-#include "whitted/scene/mesh_file.h"
+#include "scene/mesh_file.h"
 
 #include <cmath>
 #include <cstddef>

@@ -8,8 +8,8 @@
 
 #include "converters/pov_writer.h"
 #include "fuzz_support.h"
-#include "whitted/scene/description.h"
-#include "whitted/scene/scene.h"
+#include "scene/description.h"
+#include "scene/scene.h"
 
 #include <cctype>
 #include <cstddef>

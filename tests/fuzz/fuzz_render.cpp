@@ -9,10 +9,10 @@
 // width), the machine's widest when unset; scripts/fuzz and the replay tests run both.
 
 #include "fuzz_support.h"
-#include "whitted/render/accelerator.h"
-#include "whitted/render/renderer.h"
-#include "whitted/scene/description.h"
-#include "whitted/scene/scene.h"
+#include "render/accelerator.h"
+#include "render/renderer.h"
+#include "scene/description.h"
+#include "scene/scene.h"
 
 #include <algorithm>
 #include <cstddef>

@@ -6,8 +6,8 @@
 // tests/robustness/mutate_scenes.py.
 
 #include "fuzz_support.h"
-#include "whitted/scene/description.h"
-#include "whitted/scene/scene.h"
+#include "scene/description.h"
+#include "scene/scene.h"
 
 #include <cmath>
 #include <cstddef>

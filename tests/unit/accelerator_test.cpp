@@ -4,10 +4,10 @@
 // for every packet size from 1 to 16 and every instruction set (4-, 8- and 16-wide Embree
 // packets); and WHITTED_EMBREE_ISA is checked by name.
 
-#include "whitted/render/accelerator.h"
-#include "whitted/compat/povray/mesh2.h"
-#include "whitted/geometry/shapes.h"
-#include "whitted/scene/scene.h"
+#include "render/accelerator.h"
+#include "compat/povray/mesh2.h"
+#include "geometry/shapes.h"
+#include "scene/scene.h"
 
 #include "test_support.h"
 

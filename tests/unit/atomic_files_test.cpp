@@ -2,7 +2,7 @@
 // Files written so that they appear complete or not at all (`whitted convert`'s .pov and .ini):
 // the bytes land exactly, existing files are replaced, and a failure leaves no temporary file.
 
-#include "whitted/output/atomic_files.h"
+#include "output/atomic_files.h"
 
 #include "test_support.h"
 

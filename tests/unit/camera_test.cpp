@@ -3,8 +3,8 @@
 // y0 = 0.5 − (j + 0.5)/H; horizontal fov; right-handed (looking down −z with up +y, screen-right
 // is +x). Expected directions are built here from those formulas, not from the camera code.
 
-#include "whitted/render/camera.h"
-#include "whitted/scene/scene.h"
+#include "render/camera.h"
+#include "scene/scene.h"
 
 #include <gtest/gtest.h>
 

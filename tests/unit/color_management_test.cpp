@@ -5,7 +5,7 @@
 // → P3-D65 matrix, every Raw view is the identity; each is recognised as what it is (the
 // encoding the files declare), and unknown names are refused with a message listing what exists.
 
-#include "whitted/output/color_management.h"
+#include "output/color_management.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

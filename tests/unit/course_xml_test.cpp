@@ -3,11 +3,11 @@
 // description, with its place; the window camera against the course's formula written out here;
 // Schlick's factor against its closed form.
 
-#include "whitted/scene/course_xml.h"
-#include "whitted/render/camera.h"
-#include "whitted/render/shading.h"
-#include "whitted/scene/scene.h"
-#include "whitted/scene/text_checks.h"
+#include "scene/course_xml.h"
+#include "render/camera.h"
+#include "render/shading.h"
+#include "scene/scene.h"
+#include "scene/text_checks.h"
 
 #include <gtest/gtest.h>
 

@@ -4,10 +4,10 @@
 // the packing, sending and assembly of tiles give the one-process image bit for bit. The same
 // over MPI, with real ranks: tests/mpi (label mpi).
 
-#include "whitted/render/distributed.h"
-#include "whitted/render/accelerator.h"
-#include "whitted/render/renderer.h"
-#include "whitted/scene/scene.h"
+#include "render/distributed.h"
+#include "render/accelerator.h"
+#include "render/renderer.h"
+#include "scene/scene.h"
 
 #include "test_support.h"
 

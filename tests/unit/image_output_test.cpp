@@ -3,7 +3,7 @@
 // the metadata, a finished image replaces an existing one, and a failed write leaves the old
 // file as it was and no temporary file behind.
 
-#include "whitted/output/image_output.h"
+#include "output/image_output.h"
 
 #include "test_support.h"
 #include "whitted/version.h"

@@ -4,12 +4,12 @@
 // layers are the same for any thread count; explain_pixel gives every pixel of the render
 // without layers, bit for bit. Read back from the EXR by other programs: tests/layers.
 
-#include "whitted/render/layers.h"
-#include "whitted/render/accelerator.h"
-#include "whitted/render/camera.h"
-#include "whitted/render/explain.h"
-#include "whitted/render/renderer.h"
-#include "whitted/scene/scene.h"
+#include "render/layers.h"
+#include "render/accelerator.h"
+#include "render/camera.h"
+#include "render/explain.h"
+#include "render/renderer.h"
+#include "scene/scene.h"
 
 #include "test_support.h"
 

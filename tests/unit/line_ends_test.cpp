@@ -3,11 +3,11 @@
 // a mistake on line 3 is named at line 3 whichever the file uses, and in OBJ and MTL files a lone
 // CR also ends a statement (docs/robustness.md).
 
-#include "whitted/scene/course_xml.h"
-#include "whitted/scene/mesh_file.h"
-#include "whitted/scene/msh_file.h"
-#include "whitted/scene/nff_file.h"
-#include "whitted/scene/scene.h"
+#include "scene/course_xml.h"
+#include "scene/mesh_file.h"
+#include "scene/msh_file.h"
+#include "scene/nff_file.h"
+#include "scene/scene.h"
 
 #include "test_support.h"
 

@@ -231,7 +231,7 @@ TEST(LoadScene, HandsEachObjectOnceWhenTheFileIsReadAgainByLibyaml) {
     std::vector<double> radii;
     const ObjectSink sink = [&](ObjectDescription&& object, size_t index) {
         indices.push_back(index);
-        radii.push_back(object.radius.value);
+        radii.push_back(std::get<SphereShape>(object.shape).radius.value);
     };
     (void)parse_scene_text(text, "anchors.yaml", &sink);
     EXPECT_THAT(indices, testing::ElementsAre(0u, 1u, 2u, 3u));

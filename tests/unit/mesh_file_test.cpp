@@ -2,8 +2,8 @@
 // Wavefront OBJ + MTL loading: the MTL's Ka/Kd/Ks/Ns become ka/kd/ks/p, `illum 3` (reflection)
 // makes km = Ks, polygons are split into triangles, and bad files are refused naming the file.
 
-#include "whitted/scene/mesh_file.h"
-#include "whitted/scene/scene.h"
+#include "scene/mesh_file.h"
+#include "scene/scene.h"
 
 #include "test_support.h"
 

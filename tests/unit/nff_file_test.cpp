@@ -3,9 +3,9 @@
 // the plain description, with its place; the mapping of `f`; the camera of SPD's own POV-Ray
 // output written out here; every malformed entity refused with its FILE:LINE:COL.
 
-#include "whitted/scene/nff_file.h"
-#include "whitted/render/camera.h"
-#include "whitted/scene/scene.h"
+#include "scene/nff_file.h"
+#include "render/camera.h"
+#include "scene/scene.h"
 
 #include <gtest/gtest.h>
 

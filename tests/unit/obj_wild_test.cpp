@@ -3,10 +3,10 @@
 // mark, Latin-1 names, numbers too small for a float, `mtllib` with several files, undefined
 // materials and faces without any. Areas are closed-form; messages keep FILE:LINE:COL.
 
-#include "whitted/render/accelerator.h"
-#include "whitted/render/renderer.h"
-#include "whitted/scene/mesh_file.h"
-#include "whitted/scene/scene.h"
+#include "render/accelerator.h"
+#include "render/renderer.h"
+#include "scene/mesh_file.h"
+#include "scene/scene.h"
 
 #include "test_support.h"
 

@@ -4,8 +4,8 @@
 // parse_scene_text, ranges and cross-references by validate_scene; both are exercised through
 // test::scene_error, which runs the two in sequence.
 
-#include "whitted/scene/description.h"
-#include "whitted/scene/scene.h"
+#include "scene/description.h"
+#include "scene/scene.h"
 
 #include "test_support.h"
 

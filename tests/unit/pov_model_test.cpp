@@ -4,10 +4,10 @@
 // 0.2·(1 − 0.5^N) at max_depth N). The §6 scene is written in POV-Ray's left-handed numbers;
 // in Whitted's right-handed format x is mirrored, so the light moves from (−5, 5, −5) to (5, 5, −5).
 
-#include "whitted/render/accelerator.h"
-#include "whitted/render/renderer.h"
-#include "whitted/render/shading.h"
-#include "whitted/scene/scene.h"
+#include "render/accelerator.h"
+#include "render/renderer.h"
+#include "render/shading.h"
+#include "scene/scene.h"
 
 #include "test_support.h"
 

@@ -4,7 +4,7 @@
 // lecture's material becomes recipe A (one texture, grey ks) or recipe B (four layered textures).
 
 #include "converters/pov_writer.h"
-#include "whitted/scene/description.h"
+#include "scene/description.h"
 
 #include "test_support.h"
 

@@ -4,10 +4,10 @@
 // (pov.cube_field, pov.cube_field_turned); here, what holds without POV-Ray: the nearest hit is
 // never lost, the order without a hierarchy is the file's, and what is not covered says so.
 
-#include "whitted/compat/povray/tie_order.h"
+#include "compat/povray/tie_order.h"
 
-#include "whitted/geometry/shapes.h"
-#include "whitted/scene/scene.h"
+#include "geometry/shapes.h"
+#include "scene/scene.h"
 
 #include "test_support.h"
 

@@ -6,9 +6,9 @@
 // other thread counts and every Embree instruction set: tests/isa/isa_identical.py. Packets
 // against single rays on random rays: accelerator_test.cpp.
 
-#include "whitted/render/accelerator.h"
-#include "whitted/render/renderer.h"
-#include "whitted/scene/scene.h"
+#include "render/accelerator.h"
+#include "render/renderer.h"
+#include "scene/scene.h"
 
 #include "test_support.h"
 

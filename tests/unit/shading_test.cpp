@@ -4,9 +4,9 @@
 // with the scene-format v1 rules: the n·l gate removes both terms, a shadowed light adds
 // neither, directional lights have l = −direction everywhere.
 
-#include "whitted/render/shading.h"
-#include "whitted/render/accelerator.h"
-#include "whitted/scene/scene.h"
+#include "render/shading.h"
+#include "render/accelerator.h"
+#include "scene/scene.h"
 
 #include <gtest/gtest.h>
 

@@ -2,10 +2,10 @@
 // Ray–shape intersection in closed form: distances from elementary geometry, normals from the
 // shapes' definitions (for a transformed sphere, the gradient of its implicit equation).
 
-#include "whitted/geometry/shapes.h"
-#include "whitted/compat/povray/box.h"
-#include "whitted/compat/povray/mesh2.h"
-#include "whitted/core/transform.h"
+#include "geometry/shapes.h"
+#include "compat/povray/box.h"
+#include "compat/povray/mesh2.h"
+#include "core/transform.h"
 
 #include <gtest/gtest.h>
 

@@ -4,8 +4,8 @@
 // Helpers shared by the unit tests: scenes from YAML text, expected input errors, and
 // scratch directories. Kept header-only so each test executable stays self-contained.
 
-#include "whitted/scene/description.h"
-#include "whitted/scene/scene.h"
+#include "scene/description.h"
+#include "scene/scene.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -2,9 +2,9 @@
 // Transforms: list order (scale, then rotate, then translate), the right-hand rule, inverses and
 // normals, against hand-worked points.
 
-#include "whitted/core/transform.h"
-#include "whitted/geometry/shapes.h"
-#include "whitted/scene/scene.h"
+#include "core/transform.h"
+#include "geometry/shapes.h"
+#include "scene/scene.h"
 
 #include "test_support.h"
 

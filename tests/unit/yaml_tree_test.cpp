@@ -3,9 +3,9 @@
 // reads (every YAML and JSON file in the repository, and hand-written forms), the limits hold
 // while reading, and the top-level objects are handed on and forgotten one by one.
 
-#include "whitted/scene/yaml_tree.h"
-#include "whitted/scene/description.h"
-#include "whitted/scene/text_checks.h"
+#include "scene/yaml_tree.h"
+#include "scene/description.h"
+#include "scene/text_checks.h"
 
 #include "test_support.h"
 

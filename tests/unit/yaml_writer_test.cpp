@@ -4,7 +4,7 @@
 // breaks (U+0085, U+2028, U+2029) or refuses unescaped (controls, U+FEFF, U+FFFE).
 
 #include "converters/yaml_writer.h"
-#include "whitted/scene/description.h"
+#include "scene/description.h"
 
 #include <gtest/gtest.h>
 

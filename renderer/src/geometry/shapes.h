@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// Ray–shape intersection in double precision. Each function finds the nearest hit with
+// t_min < t < t_max and returns its distance and outward (not yet ray-facing) normal.
+
+#include "core/ray.h"
+#include "scene/scene.h"
+
+namespace whitted {
+
+struct ShapeHit {
+    double t = 0;
+    Vec3 normal;   ///< outward geometric normal, world space, not necessarily unit
+    double u = 0;  ///< triangles: barycentric weight of vertex 1
+    double v = 0;  ///< triangles: barycentric weight of vertex 2
+    /// Boxes: the face is not the one the ray crosses at `t` but a steeper one within 1e-6,
+    /// chosen by POV-Ray's edge rule (intersect_box); the accelerator lets another box's plain
+    /// hit at the very same t win over it, as POV-Ray's order of testing does.
+    bool edge_tie = false;
+};
+
+/// The ray in a shape's own space: the direction is not renormalised, so t means the same
+/// distance along the world ray in both spaces.
+Ray to_object_space(const Transform& to_world, const Ray& ray);
+
+bool intersect_sphere(const Sphere& sphere, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
+/// The slab test, exact: no tolerance but t_min; a ray through an edge or corner gets the face
+/// of the last axis it crosses there. (POV-Ray's, for `whitted check`: compat/povray/box.h.)
+bool intersect_box(const Box& box, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
+/// The side as a quadric in the cone's own frame (the axis and the plane across it), then the
+/// caps as discs unless the cone is open; the nearest hit. Exact in double: no tolerance but
+/// t_min. The side's normal is the gradient of |p⊥| − r(s), scaled by r(s).
+bool intersect_cone(const Cone& cone, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
+bool intersect_plane(const Plane& plane, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
+/// Möller–Trumbore; the normal is (v1 − v0) × (v2 − v0). `edge_margin` widens the triangle by
+/// that much in barycentric terms (u, v ≥ −margin, u + v ≤ 1 + margin): with a small margin a
+/// ray along an edge that two triangles share meets at least one of them despite double's
+/// rounding, which the exact test alone does not promise.
+bool intersect_triangle(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Ray& ray, double t_min, double t_max,
+                        ShapeHit& hit, double edge_margin = 0);
+
+/// Whether triangle `prim` is shaded smooth, with its vertex normals blended, rather than flat
+/// with its face normal: its mesh has vertex normals and its three are not one normal (under
+/// render.convention: course they are blended always, as the course's ray tracer does).
+bool shaded_smooth(const TriangleMesh& mesh, uint32_t prim, Convention convention);
+/// The smooth shading normal at a hit on triangle `prim` with barycentric weights u, v
+/// (ShapeHit): the unit vertex normals blended by weight, n0 (1 − u − v) + n1 u + n2 v, and made
+/// unit length, as the lecture and POV-Ray's mesh2 do. False where the triangle is shaded flat
+/// (shaded_smooth) or the blend has length 0: its face normal then shades it.
+bool blended_normal(const TriangleMesh& mesh, uint32_t prim, double u, double v, Convention convention, Vec3& out);
+/// The material of triangle `prim`: its own where the mesh has one per triangle, else the mesh's.
+uint32_t triangle_material(const TriangleMesh& mesh, uint32_t prim);
+/// The same for a prototype's triangle placed by `instance`, whose material, if it has one,
+/// overrides the prototype's.
+uint32_t triangle_material(const Instance& instance, const TriangleMesh& mesh, uint32_t prim);
+
+/// World-space bounds of a sphere, box or cone (its object-space box pushed through the transform).
+void world_bounds(const Sphere& sphere, Vec3& lo, Vec3& hi);
+void world_bounds(const Box& box, Vec3& lo, Vec3& hi);
+void world_bounds(const Cone& cone, Vec3& lo, Vec3& hi);
+/// World-space bounds of the axis-aligned box [lo, hi] of an object's space under `to_world`
+/// (the extremes of its eight corners).
+void world_bounds(const Transform& to_world, const Vec3& lo, const Vec3& hi, Vec3& out_lo, Vec3& out_hi);
+
+}  // namespace whitted

@@ -1,0 +1,398 @@
+// SPDX-License-Identifier: MIT
+// The exact decision: Embree proposes candidates in float; each is decided again in double
+// from the scene's own data and the double ray (triangles by the filter or after the query,
+// spheres, boxes and cones in their callbacks), and the planes are tested directly.
+#include "render/accelerator_impl.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <tuple>
+
+namespace whitted {
+namespace accel {
+
+namespace {
+
+/// Embree's float copy of `ray` in its frame, with `id`, its index in the query (packets:
+/// accelerator_packets.cpp, set_lane).
+RTCRay make_embree_ray(const Ray& ray, unsigned id, const EmbreeFrame& frame) {
+    const Vec3 origin = ray.origin - frame.offset;
+    RTCRay r;
+    r.org_x = float(origin.x);
+    r.org_y = float(origin.y);
+    r.org_z = float(origin.z);
+    r.dir_x = float(ray.direction.x);
+    r.dir_y = float(ray.direction.y);
+    r.dir_z = float(ray.direction.z);
+    r.tnear = frame.t_min(ray);
+    r.tfar = frame.t_max(ray);
+    r.time = 0;
+    r.mask = 0xFFFFFFFFu;
+    r.id = id;
+    r.flags = 0;
+    return r;
+}
+
+/// A sphere's, box's or cone's material and object (Scene::objects index + 1).
+std::pair<uint32_t, uint32_t> material_and_object(const Scene& scene, ShapeKind kind, unsigned prim) {
+    if (kind == ShapeKind::spheres) return {scene.spheres[prim].material, scene.spheres[prim].object};
+    if (kind == ShapeKind::cones) return {scene.cones[prim].material, scene.cones[prim].object};
+    return {scene.boxes[prim].material, scene.boxes[prim].object};
+}
+
+bool intersect_analytic(const AnalyticGeometry& geometry, unsigned prim, const Ray& ray, double t_max, ShapeHit& hit) {
+    if (geometry.kind == ShapeKind::spheres)
+        return intersect_sphere(geometry.scene->spheres[prim], ray, ray.t_min, t_max, hit);
+    if (geometry.kind == ShapeKind::cones)
+        return intersect_cone(geometry.scene->cones[prim], ray, ray.t_min, t_max, hit);
+    const Box& box = geometry.scene->boxes[prim];
+    return geometry.scene->intersection == Intersection::povray
+               ? intersect_box_as_povray(box, ray, ray.t_min, t_max, hit)
+               : intersect_box(box, ray, ray.t_min, t_max, hit);
+}
+
+/// Whether Scene::objects number `object` (index + 1) is a cylinder or cone.
+bool is_cone_object(const Scene& scene, uint32_t object) {
+    const ObjectType type = scene.objects[object - 1].type;
+    return type == ObjectType::cylinder || type == ObjectType::cone;
+}
+
+/// How far apart two surfaces a ray meets at `t` may be found and still be one tie by the exact
+/// rule (render.intersection: exact): 64 ulps of the largest coordinate or distance the two
+/// distances were computed from. A face lying in a plane is met by both at one t in real
+/// numbers, but each distance is rounded its own way; scaled or moved, the rounding differs,
+/// and without the window the order of the two would follow it.
+double tie_window(const Ray& ray, double t) {
+    const Vec3 x = ray.at(t);
+    const double largest = std::max({std::fabs(ray.origin.x), std::fabs(ray.origin.y), std::fabs(ray.origin.z),
+                                     std::fabs(x.x), std::fabs(x.y), std::fabs(x.z), std::fabs(t)});
+    return 64 * std::numeric_limits<double>::epsilon() * largest;
+}
+
+/// How far past its edges, in barycentric terms, a triangle still counts as hit by the exact
+/// test: far below any ray's float error, and far above double's rounding of u and v, so that
+/// a ray along an edge two triangles share meets at least one of them.
+constexpr double triangle_edge_margin = 1e-10;
+
+/// The decision on a triangle candidate, made in double from the scene's own float vertices
+/// and the double ray: the ray passes inside the triangle and meets it within (t_min, t_max),
+/// by the exact test (Möller–Trumbore in double), or by POV-Ray's own where `as_povray`
+/// (render.intersection: povray, the rules `whitted check` renders with: intersect_mesh2, with
+/// `instanced` for a prototype's triangle, the ray then in the prototype's space). Embree's
+/// float test only proposes candidates: it is given triangles widened beyond its rounding
+/// (Impl::add_mesh), so every triangle the double ray meets is among them, and the widened parts
+/// are refused here. hit.normal is (v1 − v0) × (v2 − v0).
+bool hit_triangle_in_double(const TriangleMesh& mesh, unsigned prim, const Ray& ray, bool as_povray, bool instanced,
+                            ShapeHit& hit) {
+    if (as_povray) return intersect_mesh2(mesh, prim, ray, instanced, hit);
+    const uint32_t* index = &mesh.indices[3 * size_t(prim)];
+    const Vec3 v0 = mesh.vertex(index[0]), v1 = mesh.vertex(index[1]), v2 = mesh.vertex(index[2]);
+    return intersect_triangle(v0, v1, v2, ray, ray.t_min, ray.t_max, hit, triangle_edge_margin);
+}
+
+/// The smooth shading normal at a hit on a triangle, unit length: the lecture's blend of the
+/// vertex normals (blended_normal), or for a mesh decided as POV-Ray decides it, POV-Ray's at
+/// `point`, the hit in the mesh's space (MeshAsPovray::smooth_normal). False where the
+/// triangle is shaded flat, with its face normal.
+bool smooth_normal(const TriangleMesh& mesh, uint32_t prim, const ShapeHit& hit, const MeshAsPovray& povray,
+                   const Vec3& point, Convention convention, Vec3& out) {
+    return povray.decided ? povray.smooth_normal(mesh, prim, point, convention, out)
+                          : blended_normal(mesh, prim, hit.u, hit.v, convention, out);
+}
+
+}  // namespace
+
+void analytic_bounds(const RTCBoundsFunctionArguments* args) {
+    const auto* geometry = static_cast<const AnalyticGeometry*>(args->geometryUserPtr);
+    Vec3 lo, hi;
+    if (geometry->kind == ShapeKind::spheres)
+        world_bounds(geometry->scene->spheres[args->primID], lo, hi);
+    else if (geometry->kind == ShapeKind::cones)
+        world_bounds(geometry->scene->cones[args->primID], lo, hi);
+    else
+        world_bounds(geometry->scene->boxes[args->primID], lo, hi);
+    lo -= geometry->offset;
+    hi -= geometry->offset;
+    // Widen by a relative margin so that float rounding of the bounds never clips a hit.
+    const Vec3 pad = (hi - lo) * 1e-6 + Vec3(1e-6);
+    lo -= pad;
+    hi += pad;
+    args->bounds_o->lower_x = std::nextafter(float(lo.x), -INFINITY);
+    args->bounds_o->lower_y = std::nextafter(float(lo.y), -INFINITY);
+    args->bounds_o->lower_z = std::nextafter(float(lo.z), -INFINITY);
+    args->bounds_o->upper_x = std::nextafter(float(hi.x), INFINITY);
+    args->bounds_o->upper_y = std::nextafter(float(hi.y), INFINITY);
+    args->bounds_o->upper_z = std::nextafter(float(hi.z), INFINITY);
+}
+
+void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
+    const auto* geometry = static_cast<const AnalyticGeometry*>(args->geometryUserPtr);
+    auto* context = reinterpret_cast<QueryContext*>(args->context);
+    RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, args->N);
+    RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, args->N);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (!args->valid[i]) continue;
+        const unsigned id = RTCRayN_id(rays, args->N, i);
+        if (!context->is_query(id)) continue;
+        const Ray& ray = context->rays[id];
+        const double limit = std::min(context->best_t[id], double(RTCRayN_tfar(rays, args->N, i)));
+        // Up to and including the limit, to see a hit at exactly the t of the one held.
+        ShapeHit hit;
+        if (!intersect_analytic(*geometry, args->primID, ray, next_up(limit), hit)) continue;
+        const auto [material, object] = material_and_object(*geometry->scene, geometry->kind, args->primID);
+        if (hit.t == limit) {
+            // At a triangle's (float) distance, or at the ray's end: the candidate does not win.
+            if (limit != context->best_t[id] || !(limit < ray.t_max)) continue;
+            // An exact tie with the sphere or box held: overlapping boxes with faces in one
+            // plane, or two equal spheres in one place.
+            const Vec3& held = context->best_normal[id];
+            // The exact rule: the tie goes to the first object in the file, whatever order
+            // Embree met them in (which differs from one instruction set to another). So does a
+            // tie with a cone, and a tie that looks the same, under POV-Ray's rules too: its
+            // order (PovrayTestOrder) knows spheres and boxes.
+            const bool by_object = geometry->scene->intersection == Intersection::exact ||
+                                   geometry->kind == ShapeKind::cones ||
+                                   is_cone_object(*geometry->scene, context->best_object[id]);
+            if (by_object || (material == context->best_material[id] && hit.normal.x == held.x &&
+                              hit.normal.y == held.y && hit.normal.z == held.z)) {
+                if (object > context->best_object[id]) continue;
+            } else if (!povray_tie_replaces(material == context->best_material[id], context->best_edge_tie[id],
+                                            hit.edge_tie, context->best_tied[id])) {
+                continue;
+            }
+        } else {
+            context->best_tied[id] = false;
+        }
+        context->best_t[id] = hit.t;
+        context->best_normal[id] = hit.normal;
+        context->best_edge_tie[id] = hit.edge_tie;
+        context->best_material[id] = material;
+        context->best_object[id] = object;
+        // Round the float distance up so Embree keeps visiting boxes that may hold a closer hit.
+        RTCRayN_tfar(rays, args->N, i) = next_up(float(hit.t));
+        RTCHitN_geomID(hits, args->N, i) = args->geomID;
+        RTCHitN_primID(hits, args->N, i) = args->primID;
+        RTCHitN_instID(hits, args->N, i, 0) = RTC_INVALID_GEOMETRY_ID;
+        RTCHitN_u(hits, args->N, i) = 0;
+        RTCHitN_v(hits, args->N, i) = 0;
+        RTCHitN_Ng_x(hits, args->N, i) = float(hit.normal.x);
+        RTCHitN_Ng_y(hits, args->N, i) = float(hit.normal.y);
+        RTCHitN_Ng_z(hits, args->N, i) = float(hit.normal.z);
+    }
+}
+
+void analytic_occluded(const RTCOccludedFunctionNArguments* args) {
+    const auto* geometry = static_cast<const AnalyticGeometry*>(args->geometryUserPtr);
+    const auto* context = reinterpret_cast<const QueryContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (!args->valid[i]) continue;
+        const unsigned id = RTCRayN_id(args->ray, args->N, i);
+        if (!context->is_query(id)) continue;
+        const Ray& ray = context->rays[id];
+        ShapeHit hit;
+        if (intersect_analytic(*geometry, args->primID, ray, ray.t_max, hit))
+            RTCRayN_tfar(args->ray, args->N, i) = -INFINITY;  // Embree's mark for "occluded"
+    }
+}
+
+/// Embree's filter for triangle candidates (hit_triangle_in_double): on the meshes' own
+/// geometry where every candidate must be decided as it is met (EmbreeFrame::exact_range);
+/// otherwise on the context of shadow rays (whose first accepted candidate ends the search)
+/// and of a ray traced again after its nearest candidate was refused.
+void triangle_filter(const RTCFilterFunctionNArguments* args) {
+    const auto* geometry = static_cast<const TriangleGeometry*>(args->geometryUserPtr);
+    const auto* context = reinterpret_cast<const QueryContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) continue;
+        const unsigned id = RTCRayN_id(args->ray, args->N, i);
+        if (!context->is_query(id)) continue;
+        const unsigned inst = RTCHitN_instID(args->hit, args->N, i, 0);
+        const Ray ray = inst == RTC_INVALID_GEOMETRY_ID
+                            ? context->rays[id]
+                            : to_object_space(*(*geometry->instance_transforms)[inst], context->rays[id]);
+        ShapeHit hit;
+        if (!hit_triangle_in_double(*geometry->mesh, RTCHitN_primID(args->hit, args->N, i), ray, geometry->as_povray,
+                                    inst != RTC_INVALID_GEOMETRY_ID, hit))
+            args->valid[i] = 0;
+    }
+}
+
+}  // namespace accel
+
+using namespace accel;
+
+const PovrayTestOrder& Accelerator::Impl::tie_order() const {
+    // The threads that wait help build it (its sorts split work).
+    tbb::collaborative_call_once(tie_order_built, [&] { tie_order_data = std::make_unique<PovrayTestOrder>(scene); });
+    return *tie_order_data;
+}
+
+/// The exact hit for what Embree found on one ray (geom == invalid: nothing), then the planes.
+/// `retry` is set, and nothing is found, when Embree's nearest candidate is a triangle that
+/// the double test refuses (hit_triangle_in_double): the ray passes through the widened
+/// margin only, or meets the plane outside the range (a ray leaving a surface at a grazing
+/// angle can start on, or within rounding of, a neighbouring triangle's plane, which Embree's
+/// float distance puts past t_min while in double it is 0, behind the ray or too near). The
+/// caller traces the ray again with the double test as Embree's filter (intersect_again).
+/// `inst`: Embree's instance geomID when the candidate is a prototype's triangle (`geom` is
+/// then its mesh in the prototype), else RTC_INVALID_GEOMETRY_ID.
+bool Accelerator::Impl::finish_hit(const Ray& ray, unsigned inst, unsigned geom, unsigned prim, double best_t,
+                                   const Vec3& best_normal, bool tied, SurfaceHit& out, bool& retry) const {
+    retry = false;
+    bool found = false;
+    double t_max = ray.t_max;
+    ShapeHit hit;
+    if (geom != RTC_INVALID_GEOMETRY_ID) {
+        if (inst != RTC_INVALID_GEOMETRY_ID) {
+            // A prototype's triangle, tested in double in the prototype's space, its normals
+            // then taken to the world with the inverse transpose. A plain copy's face
+            // normal is (v1 − v0) × (v2 − v0) of the world vertices, which is the
+            // transformed one times the sign of the determinant.
+            const Instance& instance = scene.instances[mesh_of_geometry[inst]];
+            const Transform& to_world = instance.object_to_world;
+            const TriangleMesh& mesh = scene.prototypes[instance.prototype].meshes[geom];
+            const MeshAsPovray& povray = prototype_povray[instance.prototype][geom];
+            if (!hit_triangle_in_double(mesh, prim, to_object_space(to_world, ray), povray.decided, true, hit))
+                return retry = true, false;
+            const double handedness = to_world.determinant() < 0 ? -1.0 : 1.0;
+            out.geometric_normal = normalize(to_world.apply_normal(hit.normal)) * handedness;
+            Vec3 smooth;
+            // POV-Ray takes the world point back into the mesh's space for its normal.
+            out.normal =
+                smooth_normal(mesh, prim, hit, povray, to_world.inverse_point(ray.at(hit.t)), scene.convention, smooth)
+                    ? normalize(to_world.apply_normal(smooth))
+                    : out.geometric_normal;
+            out.material = triangle_material(instance, mesh, prim);
+            out.object = instance.object;
+        } else if (kinds[geom] == ShapeKind::triangles) {
+            const TriangleMesh& mesh = scene.meshes[mesh_of_geometry[geom]];
+            const MeshAsPovray& povray = world_povray[mesh_of_geometry[geom]];
+            if (!hit_triangle_in_double(mesh, prim, ray, povray.decided, false, hit)) return retry = true, false;
+            out.geometric_normal = normalize(hit.normal);
+            Vec3 smooth;
+            out.normal = smooth_normal(mesh, prim, hit, povray, ray.at(hit.t), scene.convention, smooth)
+                             ? smooth
+                             : out.geometric_normal;
+            out.material = triangle_material(mesh, prim);
+            out.object = mesh.object;
+        } else {
+            // The callback computed this hit in double and kept it; of several at exactly
+            // that t, the one POV-Ray tests first shows (PovrayTestOrder).
+            hit.t = best_t;
+            Vec3 normal = best_normal;
+            ShapeKind kind = kinds[geom];
+            PovrayTestOrder::Found first;
+            if (tied && tie_order().nearest(ray, first, best_t) && first.hit.t == best_t)
+                kind = first.sphere ? ShapeKind::spheres : ShapeKind::boxes, prim = first.index,
+                normal = first.hit.normal;
+            out.normal = out.geometric_normal = normalize(normal);
+            std::tie(out.material, out.object) = material_and_object(scene, kind, prim);
+        }
+        out.t = hit.t;
+        t_max = hit.t;
+        found = true;
+    }
+    // A tie between a plane and the shape found (the bottom of a box standing on the floor,
+    // met by a ray inside the box), by the exact rule: the two distances within tie_window
+    // of each other (a tie in real numbers that rounding split) and the first object in the
+    // file keeps it. Under POV-Ray's rules the plane keeps a tie within an ulp, as POV-Ray
+    // shows it there (docs/pov-model.md §3, "A plane keeps a tie"). Among the planes the
+    // first one keeps it either way.
+    const bool povray = scene.intersection == Intersection::povray;
+    bool plane_found = false;
+    for (const Plane& plane : scene.planes) {
+        const double window = found && !povray ? tie_window(ray, t_max) : 0.0;
+        const double limit = found && povray && !plane_found ? next_up(t_max) : t_max + window;
+        ShapeHit plane_hit;
+        if (!intersect_plane(plane, ray, ray.t_min, limit, plane_hit)) continue;
+        if (!povray && found && !(plane_hit.t < t_max - window) && plane.object > out.object) continue;
+        t_max = plane_hit.t;
+        out.t = plane_hit.t;
+        out.normal = out.geometric_normal = plane.normal;
+        out.material = plane.material;
+        out.object = plane.object;
+        found = plane_found = true;
+    }
+    if (found) out.point = ray.at(out.t);
+    return found;
+}
+
+/// The nearest hit on `ray`: Embree's nearest candidate, when the double test accepts it.
+bool Accelerator::Impl::intersect(const Ray& ray, SurfaceHit& out) const {
+    return starts_afar(ray) ? intersect_from_afar(ray, out) : intersect_from_here(ray, out);
+}
+
+/// intersect for a ray that does not start afar (or has been brought near).
+bool Accelerator::Impl::intersect_from_here(const Ray& ray, SurfaceHit& out) const {
+    bool retry = false;
+    const bool found = trace(ray, nullptr, out, retry);
+    return retry ? intersect_again(ray, out) : found;
+}
+
+/// intersect for a ray that starts_afar: a plane it meets before it reaches the finite shapes'
+/// cube, else what it meets from there on (toward_finite_shapes).
+bool Accelerator::Impl::intersect_from_afar(const Ray& ray, SurfaceHit& out) const {
+    Ray near;
+    double skipped = 0;
+    bool retry = false;
+    if (!toward_finite_shapes(ray, near, skipped))
+        return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, {}, false, out, retry);
+    Ray before = ray;
+    before.t_max = std::min(ray.t_max, skipped);
+    if (before.t_max > before.t_min &&
+        finish_hit(before, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, {}, false, out, retry))
+        return true;
+    if (!intersect_from_here(near, out)) return false;
+    out.t += skipped;
+    return true;
+}
+
+/// The nearest hit on a ray whose nearest candidate the double test refused (finish_hit):
+/// traced again with that test as Embree's filter, so that Embree goes on past every
+/// refused candidate to the nearest accepted one. Only such rays pay for the filter's call
+/// per candidate (a few percent of the rays that meet a mesh, those near an edge).
+bool Accelerator::Impl::intersect_again(const Ray& ray, SurfaceHit& out) const {
+    bool retry = false;
+    const bool found = trace(ray, triangle_filter, out, retry);
+    if (!retry) return found;
+    // Not expected (the filter refuses what finish_hit would); if it came, the planes answer.
+    return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, {}, false, out, retry);
+}
+
+/// One Embree query for `ray` with `filter` on its context (null: none), and finish_hit.
+bool Accelerator::Impl::trace(const Ray& ray, RTCFilterFunctionN filter, SurfaceHit& out, bool& retry) const {
+    QueryContext context(&ray, nullptr, 1, false);
+    context.embree.filter = filter;
+    context.start(0, ray);
+    RTCRayHit rayhit;
+    rayhit.ray = make_embree_ray(ray, 0, frame);
+    rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(rtc_scene, &context.embree, &rayhit);
+    return finish_hit(ray, rayhit.hit.instID[0], rayhit.hit.geomID, rayhit.hit.primID, context.best_t[0],
+                      context.best_normal[0], context.best_tied[0], out, retry);
+}
+
+/// Calls `lanes.operator()<W>(first)` for first = 0, W, 2W, ... < count, with W the native
+
+bool Accelerator::Impl::occluded(const Ray& ray) const {
+    if (occluded_by_plane(ray)) return true;
+    if (starts_afar(ray)) {
+        Ray near;
+        double skipped = 0;
+        return toward_finite_shapes(ray, near, skipped) && near.t_max > near.t_min && occluded_in_bvh(near);
+    }
+    return occluded_in_bvh(ray);
+}
+
+/// Embree's answer for a shadow ray, the planes aside.
+bool Accelerator::Impl::occluded_in_bvh(const Ray& ray) const {
+    QueryContext context(&ray, nullptr, 1, false);
+    context.embree.filter = shadow_filter();
+    RTCRay r = make_embree_ray(ray, 0, frame);
+    rtcOccluded1(rtc_scene, &context.embree, &r);
+    return r.tfar < 0;
+}
+
+}  // namespace whitted

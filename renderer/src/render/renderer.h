@@ -1,0 +1,91 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include "render/accelerator.h"
+#include "render/layers.h"
+#include "render/shading.h"
+#include "scene/scene.h"
+#include "whitted/image.h"
+#include "whitted/progress.h"
+
+#include <atomic>
+#include <functional>
+#include <optional>
+#include <vector>
+
+namespace whitted {
+
+// Image, the film every part shares, is public: whitted/image.h.
+
+/// A rectangle of pixels, [x_begin, x_end) × [y_begin, y_end).
+struct TileRect {
+    int x_begin, x_end, y_begin, y_end;
+    size_t pixels() const { return size_t(x_end - x_begin) * size_t(y_end - y_begin); }
+    bool overlaps(const TileRect& other) const {
+        return x_begin < other.x_end && other.x_begin < x_end && y_begin < other.y_end && other.y_begin < y_end;
+    }
+};
+
+/// What the tile renderer is asked to do: the library's side of api::RenderOptions (which the
+/// API turns into this), with the crop as tiles, the layers parsed, and the hooks only the
+/// library itself uses (where tiles come from and go to, for a distributed render).
+struct RenderJob {
+    int threads = 0;  ///< 0 = all cores
+    /// Render only the tiles that overlap this window of the image (`whitted render --crop`):
+    /// the image is still the whole image, black outside those tiles; crop_image() cuts it out.
+    /// Each pixel is the one the whole render gives, bit for bit.
+    std::optional<TileRect> crop;
+    /// Render layers to compute. With any, the beauty is the float sum of the colour layers
+    /// (docs/layers.md); without, the render takes the path that knows nothing of layers.
+    LayerSet layers;
+    /// Set from outside (a signal handler) to stop early; checked before every tile.
+    const std::atomic<bool>* cancel = nullptr;
+    /// Called from one thread a few times a second while rendering (e.g. a progress bar).
+    std::function<void(const api::Progress&)> on_progress;
+    /// Where the tiles come from (a distributed render: docs/distributed.md). Unset: every tile,
+    /// spread over the threads. Set: each worker thread asks it for a tile index (row-major,
+    /// tile_rect) until it returns false, so this process renders only the tiles it is given;
+    /// it is called from several threads at once.
+    std::function<bool(size_t& tile)> next_tile;
+    /// Called from the worker thread that finished `tile`, once its pixels are in `image`
+    /// (only that tile's rectangle is final; other tiles are being written meanwhile).
+    std::function<void(size_t tile, const struct Image& image, const RayCounts& counts)> on_tile_done;
+};
+
+/// render() works in square tiles of this many pixels a side, numbered row by row.
+constexpr int render_tile_size = 32;
+size_t render_tile_count(int width, int height);
+TileRect render_tile_rect(int width, int height, size_t tile);
+
+/// What render() gives back: the whole image (black outside the tiles rendered), from which
+/// the API makes an api::RenderResult (cut to the crop window, the rays as RenderStats).
+struct RenderedTiles {
+    Image image;
+    RayCounts rays;
+    double seconds = 0;
+    bool cancelled = false;
+};
+
+/// The tiles (their numbers, ascending) that overlap `window`.
+std::vector<size_t> render_tiles_overlapping(const Scene& scene, const TileRect& window);
+/// The window's pixels of `image` (every layer too), as an image of the window's size.
+Image crop_image(const Image& image, const TileRect& window);
+
+/// Renders the scene in tiles on all (or `threads`) cores. Every pixel depends only on the
+/// scene, never on the order tiles finish, so the image is bit-identical for any thread count.
+RenderedTiles render(const Scene& scene, const Accelerator& accelerator, const RenderJob& options);
+
+/// One pixel, all its samples averaged (box filter).
+Color render_pixel(const Scene& scene, const LectureShading& shading, int i, int j, RayCounts& counts);
+
+/// The camera rays render() traces together in one packet, and which of them are pixel (i, j)'s.
+struct CameraPacket {
+    std::vector<Ray> rays;
+    std::vector<int> sample;  ///< per ray: its sample number b·n + a in pixel (i, j), or −1 (another pixel's)
+};
+/// The packets in which render() traces pixel (i, j)'s camera rays, in order: with one sample per
+/// pixel, the 4×4 block of pixels that holds it; with n×n samples, its samples 16 at a time. So
+/// `whitted explain` traces exactly what the render traced.
+std::vector<CameraPacket> camera_packets(const Scene& scene, int i, int j);
+
+}  // namespace whitted
