@@ -20,22 +20,19 @@ import math
 import os
 import re
 import shutil
-import subprocess
 import sys
 import time
 
 import numpy as np
 import OpenImageIO as oiio
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import fail, fresh_folder, run  # noqa: E402  (tests/harness.py)
+
 SCENE = "tests/pov/three_coloured_lights.yaml"
 REFERENCE = "tests/image/ref/three_coloured_lights.png"  # POV-Ray's render, exposure 1 (references.txt)
 # Debian's; $WHITTED_CHROMIUM only for browser.missing_tools, which shows a missing one fails.
 CHROMIUM = os.environ.get("WHITTED_CHROMIUM", "/usr/bin/chromium")
-
-
-def fail(message):
-    print("FAIL:", message)
-    sys.exit(1)
 
 
 def read(path):
@@ -195,8 +192,7 @@ def main():
     problems = tools_problem(tools)
     if problems:
         fail("the browser tests need Chromium, node and playwright-core:\n  " + "\n  ".join(problems))
-    shutil.rmtree(work, ignore_errors=True)
-    os.makedirs(work)
+    fresh_folder(work)
     shots = os.path.join(work, "screenshots")
     os.makedirs(shots)
 
@@ -206,10 +202,7 @@ def main():
                    "--exposure", "1", "--report", report]
         if case == "layers":
             command += ["--layers", "all"]
-        run = subprocess.run(command, capture_output=True, text=True)
-        print(run.stdout, end="")
-        if run.returncode != 0:
-            fail(f"whitted check exited {run.returncode}: {run.stderr}")
+        print(run(command).stdout, end="")
         expect = static_expectations(report) if case == "static" else expectations_for_report(report, case == "layers")
         page = os.path.join(report, "report.html")
         print(f"report-data.js: {os.path.getsize(os.path.join(report, 'report-data.js'))} bytes, "
@@ -219,11 +212,8 @@ def main():
             fail("POV-Ray is missing: apt-get install povray (scripts/setup --with-test-tools does)")
         out = os.path.join(work, "validation")
         env = dict(os.environ, WHITTED_BUILD_DIR=os.path.dirname(os.path.dirname(whitted)))
-        run = subprocess.run(["bash", os.path.join(source, "scripts", "validate"), "--out", out,
-                              os.path.join(source, SCENE)], capture_output=True, text=True, env=env)
-        print(run.stdout, end="")
-        if run.returncode != 0:
-            fail(f"scripts/validate exited {run.returncode}: {run.stdout} {run.stderr}")
+        print(run(["bash", os.path.join(source, "scripts", "validate"), "--out", out,
+                   os.path.join(source, SCENE)], env=env).stdout, end="")
         page = os.path.join(out, "index.html")
         png, _ = read(os.path.join(out, "three_coloured_lights", "ours.png"))
         expect = {"thumbnails": ["three_coloured_lights/ours.png", "three_coloured_lights/diff.png"],
@@ -243,10 +233,10 @@ def main():
                XDG_CACHE_HOME=os.path.join(home, ".cache"), XDG_DATA_HOME=os.path.join(home, ".local/share"),
                TMPDIR=os.path.join(home, "tmp"), NODE_PATH=os.path.join(tools, "node_modules"))
     start = time.monotonic()
-    run = subprocess.run(["node", os.path.join(source, "tests", "browser", "report_test.js"), case, page, expect_file,
-                          shots, CHROMIUM], env=env, timeout=120)
+    browser = run(["node", os.path.join(source, "tests", "browser", "report_test.js"), case, page, expect_file,
+                   shots, CHROMIUM], expect=None, env=env, timeout=120, stdout=None, stderr=None)
     print(f"browser part: {time.monotonic() - start:.1f} s; screenshots in {shots}")
-    sys.exit(run.returncode)
+    sys.exit(browser.returncode)
 
 
 if __name__ == "__main__":
