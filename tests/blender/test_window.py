@@ -2,8 +2,12 @@
 """ctest blender.window: a real Blender window under Xvfb (Mesa's software OpenGL): the factory scene's 3D
 view in Rendered shading with Whitted; its pixels on screen equal `whitted render` of the scene text the
 viewport rendered, through the Standard view transform (sRGB), within 8-bit display quantisation; leaving
-Rendered shading ends the render thread. Fails (does not skip) without Xvfb or a GL context.
-Usage: test_window.py [SCREENSHOT_COPY]"""
+Rendered shading ends the render thread. Then the material preview (the icon Blender renders through the
+engine from its preview scene): the engine's pixels equal `whitted render` of the preview scene text bit
+for bit, Blender's icon equals them through the sRGB curve within its dither, the material's colour is
+at the sphere's centre and follows an edit; a refused material and a missing module give an error and
+no crash. Fails (does not skip) without Xvfb or a GL context.
+Usage: test_window.py [SCREENSHOT_COPY [PREVIEW_COPY]]"""
 import json, os, shutil, sys, tempfile
 import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -58,9 +62,54 @@ assert (no_cm > 8).mean() > 0.5, "the drawn pixels look linear: the display tran
 assert res["alive_before"] and not res["alive_after_solid"], res
 if len(sys.argv) > 1:
     shutil.copyfile(os.path.join(out, "screen.png"), sys.argv[1])
+
+
+def srgb_codes(linear):
+    c = np.clip(linear, 0.0, 1.0)  # Standard: the sRGB curve, clipped
+    return np.rint(255 * np.where(c <= 0.0031308, 12.92 * c, 1.055 * c ** (1 / 2.4) - 0.055)).astype(int)
+
+
+# The material preview. Blender's rows start at the bottom; whitted render's at the top.
+pv = res["preview"]
+assert list(pv) == ["red", "blue", "refused", "missing", "again"], pv
+centre = {}
+for name in ("red", "blue", "again"):
+    p = pv[name]
+    assert p["error"] is None, (name, p)
+    run([os.environ["WHITTED"], "render", os.path.join(out, f"preview_{name}.json"), "-o", os.path.join(out, f"preview_{name}.exr")])
+    cli = oiio.ImageBuf(os.path.join(out, f"preview_{name}.exr")).get_pixels(oiio.FLOAT)[:, :, :3]
+    engine = np.load(os.path.join(out, f"preview_{name}.npy"))
+    icon = np.load(os.path.join(out, f"preview_{name}_icon.npy"))
+    assert engine.shape[:2] == cli.shape[:2] == icon.shape[:2] == tuple(p["icon_size"][::-1]), (engine.shape, cli.shape, icon.shape)
+    assert np.array_equal(engine[::-1, :, :3], cli), f"{name}: {np.count_nonzero(engine[::-1, :, :3] != cli)} values differ"
+    background = json.load(open(os.path.join(out, f"preview_{name}.json")))["image"]["background"]
+    assert (np.abs(cli - background).max(axis=2) > 0.01).mean() > 0.2, f"{name}: the preview is mostly background"
+    codes = np.abs(np.rint(255 * icon[:, :, :3]).astype(int) - srgb_codes(engine[:, :, :3])).max(axis=2)
+    p["icon_within_2"], p["icon_max_diff"] = float((codes <= 2).mean()), int(codes.max())
+    assert p["icon_within_2"] >= 0.999 and p["icon_max_diff"] <= 4, (name, p)
+    h, w = cli.shape[:2]
+    centre[name] = cli[h // 2, w // 2]
+red, blue = centre["red"], centre["blue"]
+assert red[0] > 2 * max(red[1], red[2]) and blue[2] > 2 * max(blue[0], blue[1]), centre  # the material's colour
+assert np.array_equal(centre["again"], blue), centre  # after the errors, the same preview again
+for name, words in (("refused", "negative component"), ("missing", "cannot import")):
+    p = pv[name]
+    assert p["error"] and words in p["error"] and "Traceback" not in p["error"], (name, p)
+    # transparent, not the previous material's preview left in place
+    assert p["icon_max"] == 0.0, (name, p)
+if len(sys.argv) > 2:
+    icon = np.load(os.path.join(out, "preview_red_icon.npy"))[::-1]
+    buf = oiio.ImageBuf(oiio.ImageSpec(icon.shape[1], icon.shape[0], 4, oiio.UINT8))
+    buf.set_pixels(oiio.ROI(), np.rint(255 * icon).astype(np.uint8))
+    assert buf.write(sys.argv[2]), buf.geterror()
 coarse = next(e for e in res["log"] if e[0] == "coarse")
 full = next(e for e in res["log"] if e[0] == "full")
 print(f"blender.window: {res['gl_renderer']}; view {rg['width']}x{rg['height']}: {100 * within:.3f}% of "
       f"{d.size} pixels within 2 codes of whitted render + sRGB, max {d.max()}; coarse {coarse[1]}x{coarse[2]} "
       f"after {coarse[3]:.3f} s, full after {full[3]:.3f} s; thread ended {res['stopped_after_seconds']:.2f} s "
-      f"after leaving Rendered")
+      f"after leaving Rendered; material preview {pv['red']['icon_size'][0]}x{pv['red']['icon_size'][1]}: "
+      f"identical to whitted render, icon within {max(pv[k]['icon_max_diff'] for k in ('red', 'blue', 'again'))} "
+      "codes of it + sRGB; engine export/total " +
+      ", ".join(f"{pv[k]['export_seconds']:.2f}/{pv[k]['seconds']:.2f} s" for k in ("red", "blue", "again")) +
+      "; Blender's job " + ", ".join(f"{pv[k]['job_seconds']:.2f}" for k in pv) + " s; refused material and "
+      "missing module: error, transparent icon")

@@ -1,9 +1,13 @@
 # Run inside a windowed Blender (`xvfb-run blender --factory-startup FILE.blend --python tests/blender/window_checks.py
 # -- OUTDIR`; FILE.blend the factory scene saved, so that no splash screen covers the view):
 # puts the factory scene's 3D view in Rendered shading with Whitted, waits for the full image, takes a
-# screenshot, then leaves Rendered shading and checks the render thread ended. Writes OUTDIR/result.json,
-# OUTDIR/screen.png and OUTDIR/view.json (the scene text the viewport rendered) for test_window.py.
+# screenshot, then leaves Rendered shading and checks the render thread ended. Then the material
+# preview: Blender renders its preview scene through the engine (is_preview) in its preview job, which
+# a background Blender cannot run (it has no preview scene), hence here. Writes OUTDIR/result.json,
+# OUTDIR/screen.png, OUTDIR/view.json (the scene text the viewport rendered) and per preview case
+# OUTDIR/preview_CASE.json (its scene text) and .npy (the engine's float pixels and Blender's icon).
 import json, os, sys, time, traceback, bpy
+import numpy as np
 out = sys.argv[sys.argv.index("--") + 1]
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "plugins", "blender"))
 import whitted_blender
@@ -82,9 +86,67 @@ def tick():
                 return 0.1
             res['alive_after_solid'] = s._thread.is_alive()
             res['stopped_after_seconds'] = now - state['solid_at']
-            return finish()
+            state['phase'] = 'preview'
+            return 0.05
+        if state['phase'] == 'preview':
+            return preview_tick(now)
     except Exception:
         return finish(traceback.format_exc())
+
+
+E = whitted_blender.WhittedRenderEngine
+material = bpy.data.objects['Cube'].active_material
+principled = material.node_tree.nodes['Principled BSDF'].inputs
+real_whitted = whitted_blender._whitted
+
+
+def missing_module():
+    raise whitted_blender.ModuleNotFound("Whitted: cannot import the 'whitted' Python module (test)")
+
+
+# (case, what to change before the preview renders); each case's preview is a fresh icon render.
+preview_cases = [
+    ('red', lambda: principled['Base Color'].__setattr__('default_value', (0.8, 0.05, 0.05, 1))),
+    ('blue', lambda: principled['Base Color'].__setattr__('default_value', (0.05, 0.05, 0.8, 1))),
+    ('refused', lambda: principled['Metallic'].__setattr__('default_value', 1.5)),  # kd < 0
+    ('missing', lambda: (principled['Metallic'].__setattr__('default_value', 0.0),
+                         setattr(whitted_blender, '_whitted', missing_module))),
+    ('again', lambda: setattr(whitted_blender, '_whitted', real_whitted)),
+]
+res['preview'] = {}
+
+
+def preview_tick(now):
+    """One preview case per call sequence: change, request the icon render, wait for its job."""
+    p = state.setdefault('preview', {'case': 0, 'requested': None})
+    if now - state['solid_at'] > 110:
+        return finish(f"timed out in preview case {p['case']}")
+    if p['case'] == len(preview_cases):
+        return finish()
+    name, change = preview_cases[p['case']]
+    if p['requested'] is None:
+        change()
+        E.last_preview, E.last_error = None, None
+        with bpy.context.temp_override(id=material):
+            bpy.ops.ed.lib_id_generate_preview()
+        p['requested'] = now
+        return 0.05
+    if bpy.app.is_job_running('RENDER_PREVIEW') or (E.last_preview is None and E.last_error is None):
+        return 0.05
+    icon = np.array(material.preview.image_pixels_float[:], dtype=np.float32)
+    size = tuple(material.preview.image_size)
+    r = {'error': E.last_error, 'icon_size': size, 'icon_max': float(icon.max()),
+         'job_seconds': now - p['requested']}
+    if E.last_preview is not None:
+        r['seconds'], r['export_seconds'] = E.last_preview['seconds'], E.last_preview['export_seconds']
+        with open(os.path.join(out, f"preview_{name}.json"), "w") as f:
+            f.write(E.last_preview['text'])
+        np.save(os.path.join(out, f"preview_{name}.npy"), E.last_preview['rgba'])
+    np.save(os.path.join(out, f"preview_{name}_icon.npy"), icon.reshape(size[1], size[0], 4))
+    res['preview'][name] = r
+    p['case'] += 1
+    p['requested'] = None
+    return 0.05
 
 
 bpy.app.timers.register(tick, first_interval=0.5)

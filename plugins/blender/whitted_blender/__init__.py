@@ -12,7 +12,7 @@ bl_info = {
 import os
 import sys
 import tempfile
-
+import time
 import weakref
 
 import bpy
@@ -33,9 +33,9 @@ def _whitted():
     return import_whitted(__file__)
 
 
-def scene_text(depsgraph):
+def scene_text(depsgraph, preview=False):
     from .export import describe
-    return dumps(describe(depsgraph))
+    return dumps(describe(depsgraph, preview=preview))
 
 
 class WhittedSceneProps(bpy.types.PropertyGroup):
@@ -63,7 +63,9 @@ class WhittedLightProps(bpy.types.PropertyGroup):
 class WhittedRenderEngine(bpy.types.RenderEngine):
     bl_idname = "WHITTED"
     bl_label = "Whitted"
-    bl_use_preview = False
+    # Blender calls render() on its preview scene (is_preview) for the material preview and the
+    # material, light and world icons (docs/blender.md, Material preview).
+    bl_use_preview = True
 
     # Set by the export operator: render() then writes the scene text there and renders
     # nothing. Why: Python cannot make a depsgraph evaluated for render itself, and a
@@ -73,6 +75,9 @@ class WhittedRenderEngine(bpy.types.RenderEngine):
     last_scene_text = None
     last_error = None
     last_cancelled = False
+    # The last preview render: {'text', 'rgba' (Blender's row order), 'seconds'}; kept apart from
+    # last_scene_text so that previews re-rendered on every material edit never replace F12's.
+    last_preview = None
 
     def __init__(self):
         super().__init__()
@@ -85,27 +90,43 @@ class WhittedRenderEngine(bpy.types.RenderEngine):
         breaks by itself)."""
         return self.test_break()
 
+    def _fail(self, message, depsgraph=None):
+        WhittedRenderEngine.last_error = message
+        self.report({'ERROR'}, message)
+        if depsgraph is not None and self.is_preview:
+            # Blender keeps the last preview's pixels for the next one: without a result of its
+            # own, a refused material would show the previous material's preview. Transparent.
+            r = depsgraph.scene.render
+            width = int(r.resolution_x * r.resolution_percentage / 100)
+            height = int(r.resolution_y * r.resolution_percentage / 100)
+            result = self.begin_result(0, 0, width, height)
+            result.layers[0].passes["Combined"].rect = np.zeros((width * height, 4), dtype=np.float32)
+            self.end_result(result)
+
     def render(self, depsgraph):
+        # A preview runs in Blender's preview job thread, possibly while an export waits on the
+        # main thread: it never writes the export file nor replaces the F12 scene text.
+        preview = self.is_preview
+        started = time.monotonic()
+        WhittedRenderEngine.last_error = None
         try:
-            text = scene_text(depsgraph)
-            # Kept so a test (or a user) can compare with `whitted render` of exactly this text.
-            WhittedRenderEngine.last_scene_text = text
-            if WhittedRenderEngine.export_path is not None:
-                with open(WhittedRenderEngine.export_path, "w") as f:
-                    f.write(text)
-                return
+            text = scene_text(depsgraph, preview=preview)
+            if not preview:
+                # Kept so a test (or a user) can compare with `whitted render` of exactly this text.
+                WhittedRenderEngine.last_scene_text = text
+                if WhittedRenderEngine.export_path is not None:
+                    with open(WhittedRenderEngine.export_path, "w") as f:
+                        f.write(text)
+                    return
             wm = _whitted()
             scene = wm.loads(text, "<blender>.json")
-        except MappingError as e:
-            WhittedRenderEngine.last_error = str(e)
-            self.report({'ERROR'}, str(e))
-            return
-        except ModuleNotFound as e:  # its message names the folders searched and what to set
-            self.report({'ERROR'}, str(e))
+        except (MappingError, ModuleNotFound) as e:  # messages that say "Whitted: ..." already
+            self._fail(str(e), depsgraph)
             return
         except Exception as e:  # whitted.Error: a message, not a traceback
-            self.report({'ERROR'}, f"Whitted: {e}")
+            self._fail(f"Whitted: {e}", depsgraph)
             return
+        exported = time.monotonic()
         width, height = scene.width, scene.height
         WhittedRenderEngine.last_cancelled = False
 
@@ -123,13 +144,16 @@ class WhittedRenderEngine(bpy.types.RenderEngine):
             self.end_result(result, cancel=True)
             return
         except Exception as e:
-            self.report({'ERROR'}, f"Whitted: {e}")
+            self._fail(f"Whitted: {e}")
             self.end_result(result, cancel=True)
             return
         rgba = np.ones((height, width, 4), dtype=np.float32)
         rgba[:, :, :3] = img[::-1]  # Blender's rows start at the bottom
         result.layers[0].passes["Combined"].rect = rgba.reshape(-1, 4)
         self.end_result(result)
+        if preview:
+            WhittedRenderEngine.last_preview = {'text': text, 'rgba': rgba, 'export_seconds': exported - started,
+                                                'seconds': time.monotonic() - started}
 
     # -- Rendered shading in the 3D viewport (viewport.py) --------------------------------------
     def _viewport(self, depsgraph):
@@ -380,13 +404,13 @@ class WHITTED_PT_light(WhittedPanel, bpy.types.Panel):
 
 
 def _compat_panels():
-    """Blender's own panels that EEVEE shows (material surface, world, output, ...), so they
-    show with Whitted too: the add-on reads Principled BSDF inputs and world colour from them.
-    Not the material preview (bl_use_preview is off: there would be nothing in it)."""
+    """Blender's own panels that EEVEE shows (material surface and preview, world, output, ...), so
+    they show with Whitted too: the add-on reads Principled BSDF inputs and world colour from them,
+    and renders the material preview."""
     for name in dir(bpy.types):
         panel = getattr(bpy.types, name)
         engines = getattr(panel, "COMPAT_ENGINES", None)
-        if isinstance(engines, set) and "BLENDER_EEVEE" in engines and name != "MATERIAL_PT_preview" \
+        if isinstance(engines, set) and "BLENDER_EEVEE" in engines \
                 and name.startswith(("MATERIAL_PT", "WORLD_PT", "EEVEE_MATERIAL_PT_context_material",
                                      "EEVEE_MATERIAL_PT_surface", "EEVEE_WORLD_PT_surface",
                                      "RENDER_PT_format", "RENDER_PT_color_management",

@@ -20,6 +20,19 @@ def _first_node(owner, node_type):
 
 
 def _material(mat):
+    """The lecture material of a Blender material; refuses one with a negative coefficient (a
+    Principled Metallic above 1 or Specular below 0, which the node sockets accept from a script
+    or a driver): the lecture's terms would subtract light."""
+    m = _lecture_material(mat)
+    for key in ('ka', 'kd', 'ks', 'km'):
+        value = m.get(key, 0.0)
+        if any(c < 0 for c in (value if isinstance(value, list) else [value])):
+            raise MappingError(f"Whitted: material '{mat.name}': {key} {value} has a negative component "
+                               f"(Principled Metallic must be in [0, 1], Specular at least 0)")
+    return m
+
+
+def _lecture_material(mat):
     if mat is None:
         return {'kd': 0.8, 'ka': 0.08}
     props = getattr(mat, 'whitted', None)
@@ -95,9 +108,17 @@ def scene_camera(scene, width, height):
     return camera
 
 
-def describe(depsgraph, camera=None, size=None):
+# Blender's preview scene (the Material Properties' Preview panel and the material icons) hides its
+# floor from camera rays with this material when the engine has ray visibility (Cycles' trick, so
+# the floor shows only in reflections). Whitted has no per-ray visibility: the floor is left out.
+PREVIEW_HIDDEN_FLOOR = 'FloorHidden'
+
+
+def describe(depsgraph, camera=None, size=None, preview=False):
     """The scene description of `depsgraph`. By default through the scene's camera at the render
-    resolution (F12); the viewport passes its own camera dict and (width, height) instead."""
+    resolution (F12); the viewport passes its own camera dict and (width, height) instead.
+    `preview`: Blender's material preview scene (docs/blender.md, Material preview): its area
+    lights become point lights at their centres and its camera-hidden floor is left out."""
     scene = depsgraph.scene
     r = scene.render
     if size is None:
@@ -131,6 +152,8 @@ def describe(depsgraph, camera=None, size=None):
             # After the loop: a point light's exposure needs the bounds of all the geometry.
             lights.append((ob, inst.matrix_world.copy()))
         elif ob.type in {'MESH', 'CURVE', 'SURFACE', 'META', 'FONT'}:
+            if preview and ob.active_material and ob.active_material.name == PREVIEW_HIDDEN_FLOOR:
+                continue
             # Prototype key: the evaluated mesh. Objects without modifiers that share a mesh
             # datablock (linked duplicates, collection instances of one object) evaluate to
             # the same mesh; an object with modifiers has a mesh of its own.
@@ -156,17 +179,18 @@ def describe(depsgraph, camera=None, size=None):
                     box_hi[k] = max(box_hi[k], p[k])
     box = (box_lo, box_hi) if box_lo[0] <= box_hi[0] else None
     for ob, matrix in lights:
-        desc['lights'].append(_light(ob, matrix, box))
+        desc['lights'].append(_light(ob, matrix, box, preview))
     return desc
 
 
-def _light(ob, matrix, box):
+def _light(ob, matrix, box, preview=False):
     """A Blender light in Whitted's terms: the intensity that gives a Lambertian surface the
     radiance Cycles/EEVEE give it (mapping.point_intensity, sun_intensity), unless the light's
-    Whitted "Override intensity" gives it directly."""
+    Whitted "Override intensity" gives it directly. In the preview scene (lit by two area lights)
+    an area light is a point light of the same power at its centre."""
     light = ob.data
     lp = light.whitted
-    if light.type == 'POINT':
+    if light.type == 'POINT' or (preview and light.type == 'AREA'):
         position = list(matrix.translation)
         intensity = list(lp.intensity) if lp.use_intensity else \
             point_intensity(light.energy, light.color, reference_distance(position, box))
