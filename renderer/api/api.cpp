@@ -517,6 +517,9 @@ Expected<std::string> to_povray(const Scene& scene) {
 
 Expected<std::string> write_povray(const Scene& scene, const std::string& pov_path) {
     return guarded<std::string>("converting " + scene.path(), [&]() -> Expected<std::string> {
+        // Refused before anything is written: an empty name fails only at the final rename.
+        if (pov_path.empty())
+            return plain_error("cannot write the POV-Ray scene: the path is empty", Error::Kind::bad_input);
         const Scene::Impl& loaded = impl_of(scene);
         return pov::write_pov_files(loaded.converter_description(), loaded.scene, pov_path);
     });
@@ -587,7 +590,10 @@ Expected<std::string> describe_colour_config(const std::string& config_path) {
 
 Expected<void> write_colour_config(const std::string& path) {
     return guarded<void>("writing the colour config", [&]() -> Expected<void> {
-        // Before a byte is written; /dev/full stays a device.
+        // Before a byte is written; /dev/full stays a device. An empty name would fail only at
+        // the final rename.
+        if (path.empty())
+            return plain_error("cannot write the colour config: the path is empty", Error::Kind::bad_input);
         check_can_write(path);
         refuse_symlink_target(path);
         const std::string text = DisplayTransform::builtin_config_text();

@@ -5,7 +5,7 @@ tests/python/test_stub.py checks that every public name of the built module is h
 here is in the module, and that each function's parameter names, order, keyword-only marks and
 defaults agree with pybind11's own signature; keep them in step with whitted_module.cpp.
 """
-from typing import Callable, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -152,9 +152,79 @@ def check(
     max_error: float = 64.0,
     report_dir: str = "",
     quiet: bool = True,
+    *,
+    layers: List[str] = [],
+    terms: bool = False,
+    povray_image: str = "",
+    exposure: float = 1.0,
 ) -> CheckResult:
     """`whitted check`: render the scene file with Whitted and with POV-Ray 3.7 and compare pixel by
-    pixel (tolerances in 16-bit codes)."""
+    pixel (tolerances in 16-bit codes). layers: render with these and compare the beauty, then the sum
+    of the colour layers; terms: term by term; povray_image: a stored POV-Ray 16-bit PNG instead of
+    running POV-Ray, made at `exposure`. Ctrl-C ends POV-Ray and raises KeyboardInterrupt."""
+    ...
+
+class Comparison:
+    """The outcome of whitted.compare_image_files; truthy when passed."""
+
+    @property
+    def passed(self) -> bool: ...
+    @property
+    def first_meaning(self) -> str:
+        """What the first file was read as, e.g. 'linear Rec.709 (EXR)'; empty when the sizes differ."""
+        ...
+    @property
+    def second_meaning(self) -> str: ...
+    @property
+    def fraction_within(self) -> float:
+        """Share of pixels within tolerance."""
+        ...
+    @property
+    def max_error_codes(self) -> float:
+        """Largest error of any channel, in 16-bit codes (inf with NaN/Inf values)."""
+        ...
+    @property
+    def rms_error(self) -> float:
+        """Root mean square error, linear units."""
+        ...
+    @property
+    def failures(self) -> List[str]:
+        """The rules broken, e.g. 'cap (max 1000.0 codes > 64)'."""
+        ...
+    @property
+    def verdict(self) -> str:
+        """'PASS A vs B: ...' or 'FAIL A vs B: ...', as `whitted compare` prints."""
+        ...
+    def __bool__(self) -> bool: ...
+
+def compare_image_files(
+    first: str,
+    second: str,
+    tolerance: float = 2.0,
+    min_fraction: float = 0.999,
+    max_error: float = 64.0,
+    clip: bool = False,
+) -> Comparison:
+    """`whitted compare A B`: two image files, each turned into linear Rec.709 from its colour metadata,
+    compared channel by channel (tolerances in 16-bit codes; clip: both clipped to [0, 1] first)."""
+    ...
+
+def explain(scene: Scene, x: int, y: int, threads: int = 0) -> Dict[str, Any]:
+    """`whitted explain SCENE --pixel X,Y --json`: every term of pixel (x, y)'s equation as a dict
+    (docs/explain.schema.json)."""
+    ...
+
+def explain_text(scene: Scene, x: int, y: int, summary: bool = False, threads: int = 0) -> str:
+    """`whitted explain SCENE --pixel X,Y` (summary: `--summary`): the text the program prints."""
+    ...
+
+def describe_colour_config(ocio_config: str = "") -> str:
+    """`whitted colour --list`: each display and view of the config (empty: $OCIO, else the built-in)."""
+    ...
+
+def write_colour_config(path: str) -> None:
+    """`whitted colour --write-config PATH`: the built-in OpenColorIO config, for other programs; never
+    written through a symbolic link."""
     ...
 
 class SceneBuilder:

@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: MIT
 // The Python module `whitted` over the public C++ API (whitted/whitted.h); docs/library.md.
 //
-// Rendering runs on a thread of its own with the GIL released, while the calling (main) thread
-// waits in slices of 50 ms: after each it takes the GIL to run Python's signal handlers
+// A render or a check runs on a thread of its own with the GIL released, while the calling (main)
+// thread waits in slices of 50 ms: after each it takes the GIL to run Python's signal handlers
 // (PyErr_CheckSignals: Ctrl-C raises KeyboardInterrupt there, and only in the main thread) and
-// the progress callback. Either raising cancels the render, which stops within a tile, and the
-// exception propagates to the caller.
+// the progress callback. Either raising cancels the work (a render stops within a tile, a check
+// ends POV-Ray and removes its files), and the exception propagates to the caller. Every failure
+// of the library is raised as whitted.Error with the library's message (FILE:LINE:COL); an
+// argument the library cannot be given (a thread count, a share out of range, a path with a NUL)
+// is a ValueError, and one of the wrong type pybind11's TypeError.
 
 #include "whitted/whitted.h"
 
@@ -18,6 +21,8 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <exception>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -87,52 +92,26 @@ py::array_t<float> array_of(std::shared_ptr<whitted::Image> image, float* data, 
         data, owner);
 }
 
-/// api::render on a worker thread; the GIL is released meanwhile and this (calling) thread runs
-/// the signal handlers and `progress` every 50 ms. Rethrows what either raised, after the render
-/// has stopped.
-api::RenderResult render_releasing_gil(const api::Scene& scene, api::RenderOptions options,
-                                       const py::object& progress) {
-    std::atomic<bool> cancel{false};
+/// Runs `work` on a thread of its own with the GIL released, while this (calling) thread takes
+/// the GIL every 50 ms to run Python's signal handlers (Ctrl-C raises KeyboardInterrupt there, and
+/// only in the main thread) and then `poll`, if given. A Python exception from either sets
+/// `cancel`, and is rethrown once `work` has returned (work heeds `cancel` and stops soon).
+void run_releasing_gil(const std::function<void()>& work, std::atomic<bool>& cancel,
+                       const std::function<void()>& poll = {}) {
     std::mutex mutex;
     std::condition_variable finished;
     bool done = false;
-    std::optional<api::Progress> latest;
-    std::optional<api::Expected<api::RenderResult>> result;
+    std::exception_ptr failed;  // a C++ exception from `work` (out of memory), rethrown here
     std::optional<py::error_already_set> raised;
-
-    options.cancel = &cancel;
-    options.on_progress = [&](const api::Progress& p) {
-        std::lock_guard lock(mutex);
-        latest = p;
-        return true;
-    };
-    auto poll = [&] {
-        // With the GIL held: Python's signal handlers, then the progress callback.
-        if (PyErr_CheckSignals() != 0) {
-            raised.emplace();
-            cancel.store(true);
-            return;
-        }
-        if (progress.is_none()) return;
-        std::optional<api::Progress> p;
-        {
-            std::lock_guard lock(mutex);
-            p.swap(latest);
-        }
-        if (!p) return;
-        try {
-            progress(p->tiles_done, p->tiles_total);
-        } catch (py::error_already_set& e) {
-            raised.emplace(std::move(e));
-            cancel.store(true);
-        }
-    };
     {
         py::gil_scoped_release release;
         std::thread worker([&] {
-            auto r = api::render(scene, options);
+            try {
+                work();
+            } catch (...) {
+                failed = std::current_exception();
+            }
             std::lock_guard lock(mutex);
-            result.emplace(std::move(r));
             done = true;
             finished.notify_all();
         });
@@ -141,20 +120,85 @@ api::RenderResult render_releasing_gil(const api::Scene& scene, api::RenderOptio
                 std::unique_lock lock(mutex);
                 if (finished.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; })) break;
             }
-            if (raised) continue;  // cancelled: wait for the render to stop
+            if (raised) continue;  // cancelled: wait for the work to stop
             py::gil_scoped_acquire acquire;
-            poll();
+            try {
+                if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+                if (poll) poll();
+            } catch (py::error_already_set& e) {
+                raised.emplace(std::move(e));
+                cancel.store(true);
+            }
         }
         worker.join();
     }
-    if (!raised && !progress.is_none()) poll();  // the last figures (100 %)
     if (raised) {
         raised->restore();
         throw py::error_already_set();
     }
+    if (failed) std::rethrow_exception(failed);
+}
+
+/// api::render with run_releasing_gil: `progress(tiles_done, tiles_total)` is called from this
+/// thread with the latest figures, and once more at the end.
+api::RenderResult render_releasing_gil(const api::Scene& scene, api::RenderOptions options,
+                                       const py::object& progress) {
+    std::atomic<bool> cancel{false};
+    std::mutex mutex;
+    std::optional<api::Progress> latest;
+    std::optional<api::Expected<api::RenderResult>> result;
+
+    options.cancel = &cancel;
+    options.on_progress = [&](const api::Progress& p) {
+        std::lock_guard lock(mutex);
+        latest = p;
+        return true;
+    };
+    auto report = [&] {  // with the GIL held
+        if (progress.is_none()) return;
+        std::optional<api::Progress> p;
+        {
+            std::lock_guard lock(mutex);
+            p.swap(latest);
+        }
+        if (p) progress(p->tiles_done, p->tiles_total);
+    };
+    run_releasing_gil([&] { result.emplace(api::render(scene, options)); }, cancel, report);
+    report();  // the last figures (100 %)
     api::RenderResult out = take(std::move(*result));
     if (out.cancelled) throw py::value_error("the render was cancelled");
     return out;
+}
+
+/// `f()` with the GIL released: for a call that reads or writes files. Its Expected is raised
+/// (take) by the caller, with the GIL held again: raising while it is released crashed.
+template <class F>
+auto without_gil(F&& f) {
+    py::gil_scoped_release release;
+    return f();
+}
+
+/// A path from Python: a NUL byte would end it early in the C library (writing another file
+/// than the one named), so it is refused as Python's own open() refuses it.
+const std::string& checked_path(const std::string& path, const char* what) {
+    if (path.find('\0') != std::string::npos)
+        throw py::value_error(std::string(what) + ": embedded null character in the path");
+    return path;
+}
+
+/// The pass rule (docs/validation.md) from the module's arguments, refused as `whitted compare`
+/// and `whitted check` refuse them: tolerances of at least 0, a share in [0, 1] (NaN is neither).
+api::PassRule pass_rule(double tolerance, double min_fraction, double max_error) {
+    if (!(tolerance >= 0))
+        throw py::value_error("tolerance: must be a number >= 0 (16-bit codes), not " +
+                              py::repr(py::float_(tolerance)).cast<std::string>());
+    if (!(min_fraction >= 0 && min_fraction <= 1))
+        throw py::value_error("min_fraction: must be in [0, 1], not " +
+                              py::repr(py::float_(min_fraction)).cast<std::string>());
+    if (!(max_error >= 0))
+        throw py::value_error("max_error: must be a number >= 0 (16-bit codes), not " +
+                              py::repr(py::float_(max_error)).cast<std::string>());
+    return {tolerance, min_fraction, max_error};
 }
 
 api::Vec3 vec(const std::array<double, 3>& v) {
@@ -226,7 +270,8 @@ PYBIND11_MODULE(whitted, m) {
         "load",
         [](const std::string& path, std::optional<int> width, std::optional<int> height, std::optional<int> samples,
            std::optional<int> max_depth, std::optional<std::string> intersection) {
-            return take(api::load_scene_file(path, {width, height, samples, max_depth, intersection}));
+            return take(
+                api::load_scene_file(checked_path(path, "path"), {width, height, samples, max_depth, intersection}));
         },
         py::arg("path"), py::kw_only(), py::arg("width") = py::none(), py::arg("height") = py::none(),
         py::arg("samples") = py::none(), py::arg("max_depth") = py::none(), py::arg("intersection") = py::none(),
@@ -289,6 +334,7 @@ PYBIND11_MODULE(whitted, m) {
             whitted::Image image;
             image.height = int(rgb.shape(0));
             image.width = int(rgb.shape(1));
+            checked_path(path, "path");
             image.rgb.assign(rgb.data(), rgb.data() + rgb.size());
             api::WriteOptions options;
             options.half = half;
@@ -314,7 +360,9 @@ PYBIND11_MODULE(whitted, m) {
         "The scene as POV-Ray 3.7 SDL.");
     m.def(
         "write_povray",
-        [](const api::Scene& scene, const std::string& path) { return take(api::write_povray(scene, path)); },
+        [](const api::Scene& scene, const std::string& path) {
+            return take(api::write_povray(scene, checked_path(path, "path")));
+        },
         py::arg("scene"), py::arg("path"), "Write the .pov file and its .ini; returns the .ini's path.");
 
     py::class_<api::CheckResult>(m, "CheckResult", "The outcome of whitted.check")
@@ -329,24 +377,138 @@ PYBIND11_MODULE(whitted, m) {
     m.def(
         "check",
         [](const std::string& path, int threads, double tolerance, double min_fraction, double max_error,
-           const std::string& report_dir, bool quiet) {
+           const std::string& report_dir, bool quiet, const std::vector<std::string>& layers, bool terms,
+           const std::string& povray_image, double exposure) {
+            const api::PassRule rule = pass_rule(tolerance, min_fraction, max_error);
+            if (!(exposure > 0 && exposure <= 1))
+                throw py::value_error("exposure: must be in (0, 1] (a power of two), not " +
+                                      py::repr(py::float_(exposure)).cast<std::string>());
             api::CheckOptions options;
             options.threads = checked_threads(threads);
-            options.tolerance_codes = tolerance;
-            options.min_fraction = min_fraction;
-            options.max_error_codes = max_error;
-            options.report_dir = report_dir;
+            options.tolerance_codes = rule.tolerance_codes;
+            options.min_fraction = rule.min_fraction;
+            options.max_error_codes = rule.max_error_codes;
+            options.report_dir = checked_path(report_dir, "report_dir");
             options.quiet = quiet;
-            api::Expected<api::CheckResult> result = [&] {
-                py::gil_scoped_release release;
-                return api::check(path, options);
-            }();
-            return take(std::move(result));
+            options.layers = layers;
+            options.terms = terms;
+            options.povray_image = checked_path(povray_image, "povray_image");
+            options.exposure = exposure;
+            std::atomic<bool> cancel{false};
+            options.cancel = &cancel;
+            std::optional<api::Expected<api::CheckResult>> result;
+            checked_path(path, "path");
+            run_releasing_gil([&] { result.emplace(api::check(path, options)); }, cancel);
+            return take(std::move(*result));
         },
         py::arg("path"), py::arg("threads") = 0, py::arg("tolerance") = 2.0, py::arg("min_fraction") = 0.999,
-        py::arg("max_error") = 64.0, py::arg("report_dir") = "", py::arg("quiet") = true,
-        "`whitted check`: render the scene file with Whitted and with POV-Ray 3.7 and compare pixel by pixel "
-        "(tolerances in 16-bit codes). Prints the verdict line; returns a CheckResult (truthy when passed).");
+        py::arg("max_error") = 64.0, py::arg("report_dir") = "", py::arg("quiet") = true, py::kw_only(),
+        py::arg("layers") = std::vector<std::string>{}, py::arg("terms") = false, py::arg("povray_image") = "",
+        py::arg("exposure") = 1.0,
+        R"(`whitted check`: render the scene file with Whitted and, converted, with POV-Ray 3.7 ($WHITTED_POVRAY
+or `povray`) and compare them pixel by pixel (docs/validation.md).
+
+Parameter ``path`` (str): the scene file.
+Parameter ``threads`` (int): Whitted's worker threads, 0 (all cores) to 4096.
+Parameter ``tolerance``, ``min_fraction``, ``max_error`` (float): the pass rule, as for compare_image_files.
+Parameter ``report_dir`` (str): write images, a heat map, metrics.json and report.html here; empty: none.
+Parameter ``quiet`` (bool): print only the verdict line (False: the figures too), on standard output.
+Parameter ``layers`` (list[str]): render Whitted's image with these render layers (docs/layers.md) and
+compare its beauty, then the float sum of the colour layers.
+Parameter ``terms`` (bool): check term by term (only ambient, only diffuse, only specular, each light
+alone); the result's failures name the terms that disagree.
+Parameter ``povray_image`` (str): compare with this stored POV-Ray 16-bit PNG of the converted scene
+instead of running POV-Ray; ``exposure`` (float, a power of two <= 1) is the one it was made at.
+Returns CheckResult (truthy when passed): a failed comparison is a result, not an exception.
+Raises whitted.Error (kind 'bad_input') for a scene or option it cannot check with; Ctrl-C
+(KeyboardInterrupt) ends POV-Ray, removes the temporary files and propagates. The GIL is released.)");
+
+    py::class_<api::Comparison>(m, "Comparison", "The outcome of whitted.compare_image_files; truthy when passed")
+        .def_readonly("passed", &api::Comparison::passed)
+        .def_readonly("first_meaning", &api::Comparison::first_meaning,
+                      "What the first file was read as, e.g. 'linear Rec.709 (EXR)'")
+        .def_readonly("second_meaning", &api::Comparison::second_meaning)
+        .def_readonly("fraction_within", &api::Comparison::fraction_within, "Share of pixels within tolerance")
+        .def_readonly("max_error_codes", &api::Comparison::max_error_codes,
+                      "Largest error of any channel, 16-bit codes (inf with NaN/Inf values)")
+        .def_readonly("rms_error", &api::Comparison::rms_error, "Root mean square error, linear units")
+        .def_readonly("failures", &api::Comparison::failures, "The rules broken, e.g. 'cap (max 1000.0 codes > 64)'")
+        .def_readonly("verdict", &api::Comparison::verdict, "'PASS A vs B: ...' or 'FAIL ...', as `whitted compare`")
+        .def("__bool__", [](const api::Comparison& c) { return c.passed; })
+        .def("__repr__", [](const api::Comparison& c) { return "<whitted.Comparison " + c.verdict + ">"; });
+    m.def(
+        "compare_image_files",
+        [](const std::string& first, const std::string& second, double tolerance, double min_fraction, double max_error,
+           bool clip) {
+            const api::PassRule rule = pass_rule(tolerance, min_fraction, max_error);
+            checked_path(first, "first");
+            checked_path(second, "second");
+            return take(without_gil([&] { return api::compare_image_files(first, second, rule, clip); }));
+        },
+        py::arg("first"), py::arg("second"), py::arg("tolerance") = 2.0, py::arg("min_fraction") = 0.999,
+        py::arg("max_error") = 64.0, py::arg("clip") = false,
+        R"(`whitted compare A B`: two image files (EXR, PNG, JPEG, TIFF, ...), each turned into linear
+Rec.709 from its colour metadata, compared channel by channel (docs/validation.md).
+
+Parameter ``tolerance`` (float): per-channel tolerance in 16-bit codes (1/65535), >= 0.
+Parameter ``min_fraction`` (float): share of pixels that must be within it, in [0, 1].
+Parameter ``max_error`` (float): hard cap: no channel of any pixel may differ by more, 16-bit codes.
+Parameter ``clip`` (bool): clip both to [0, 1] first (a float EXR against a PNG, which clips).
+Returns Comparison (truthy when passed): images that differ, in values or size, are a result.
+Raises whitted.Error (kind 'bad_input') for a file that cannot be read or whose colour is not
+known; ValueError for a rule out of range. The GIL is released.)");
+
+    m.def(
+        "explain",
+        [](const api::Scene& scene, int x, int y, int threads) {
+            api::ExplainOptions options;
+            options.format = api::ExplainFormat::json;
+            options.threads = checked_threads(threads);
+            const std::string text = take(without_gil([&] { return api::explain(scene, x, y, options); }));
+            return py::module_::import("json").attr("loads")(text);
+        },
+        py::arg("scene"), py::arg("x"), py::arg("y"), py::arg("threads") = 0,
+        R"(`whitted explain SCENE --pixel X,Y --json`: every term of pixel (x, y)'s equation, traced as
+the render traces it (the same numbers, bit for bit).
+
+Parameter ``x``, ``y`` (int): column and row from the top-left corner, 0-based.
+Parameter ``threads`` (int): threads for building the BVH, if no render has built it yet (0: all cores).
+Returns dict: the document docs/explain.schema.json describes (json.loads of the program's output).
+Raises whitted.Error (kind 'bad_input') for a pixel outside the image.)");
+    m.def(
+        "explain_text",
+        [](const api::Scene& scene, int x, int y, bool summary, int threads) {
+            api::ExplainOptions options;
+            options.format = summary ? api::ExplainFormat::summary : api::ExplainFormat::text;
+            options.threads = checked_threads(threads);
+            return take(without_gil([&] { return api::explain(scene, x, y, options); }));
+        },
+        py::arg("scene"), py::arg("x"), py::arg("y"), py::arg("summary") = false, py::arg("threads") = 0,
+        R"(`whitted explain SCENE --pixel X,Y` (``summary``: ``--summary``): pixel (x, y)'s equation as the
+text the program prints: every sample, segment, light and term with its numbers, or a dozen lines (the
+first hit, each term averaged over the samples, the pixel). Raises as explain does.)");
+
+    m.def(
+        "describe_colour_config",
+        [](const std::string& ocio_config) {
+            checked_path(ocio_config, "ocio_config");
+            return take(without_gil([&] { return api::describe_colour_config(ocio_config); }));
+        },
+        py::arg("ocio_config") = "",
+        R"(`whitted colour --list`: each display and view of the OpenColorIO config (empty: $OCIO, else the
+built-in one), the colour space it writes and what that means; the text the program prints.
+Raises whitted.Error for a config that cannot be read.)");
+    m.def(
+        "write_colour_config",
+        [](const std::string& path) {
+            checked_path(path, "path");
+            take(without_gil([&] { return api::write_colour_config(path); }));
+        },
+        py::arg("path"),
+        R"(`whitted colour --write-config PATH`: write the built-in OpenColorIO config (the one write_image
+uses without $OCIO) for other programs. The file appears complete or not at all; an existing file is
+replaced only by a complete one. Raises whitted.Error for a folder that does not exist, a symbolic link
+(never written through), a device or a folder that cannot be written.)");
 
     py::class_<api::SceneBuilder>(m, "SceneBuilder", "A scene built in code; each method returns the builder")
         .def(py::init<>())

@@ -5,6 +5,7 @@ Run by ctest as python.module (label python); $WHITTED is the `whitted` program 
 $WHITTED_EXAMPLES the examples directory. EXR files are read back with Debian's
 python3-openimageio, which knows nothing of Whitted.
 """
+import json
 import os
 import signal
 import subprocess
@@ -240,9 +241,12 @@ def test_check_against_povray():
         whitted.check("/nonexistent/scene.yaml")
 
 
-# Every failure of the module's functions is an exception, never a signal: each case runs in a
-# child interpreter (a crash there is a negative exit status, not a lost test run), which prints
-# the exception's type and ends with exit 0.
+# Every failure of the module's functions is an exception, never a signal. The cases run one after
+# another in one child interpreter (a crash there is a negative exit status, not a lost test run,
+# and the case it was running is named); each prints the exception's type. OUT is a folder of the
+# child's own; LINK a symbolic link in it to a file elsewhere, TEXT a text file named .png,
+# EXR a 2x2 image.
+NAN, HUGE = "float('nan')", "2**64"
 ERROR_PATHS = {
     "write_image to an unknown format": (
         "whitted.write_image(np.zeros((2, 2, 3), np.float32), OUT + '/x.bmp')", "Error"),
@@ -256,38 +260,150 @@ ERROR_PATHS = {
                                                 "ValueError"),
     "write_image of an empty array (0, 0, 3)": ("whitted.write_image(np.zeros((0, 0, 3), np.float32), OUT + '/e.exr')",
                                                 "ValueError"),
+    "write_image of None": ("whitted.write_image(None, OUT + '/n.exr')", "ValueError"),
+    "write_image to /dev/full": ("whitted.write_image(np.zeros((2, 2, 3), np.float32), '/dev/full')", "Error"),
+    "write_image into /proc": ("whitted.write_image(np.zeros((2, 2, 3), np.float32), '/proc/x.exr')", "Error"),
+    "write_image to an empty path": ("whitted.write_image(np.zeros((2, 2, 3), np.float32), '')", "Error"),
+    "write_image to a path with a NUL": ("whitted.write_image(np.zeros((2, 2, 3), np.float32), OUT + '/x.exr\\0.png')",
+                                         "ValueError"),
+    # as `whitted render -o`: the link is replaced by the image, never written through
+    "write_image onto a symlink": ("whitted.write_image(np.zeros((2, 2, 3), np.float32), LINK + '.exr')", "NOTHING"),
     "render with threads=-1": ("whitted.render(SCENE, threads=-1)", "ValueError"),
     "render with threads=10**9": ("whitted.render(SCENE, threads=10**9)", "ValueError"),
     "render with threads=2**31-1": ("whitted.render(SCENE, threads=2**31 - 1)", "ValueError"),
+    "render with threads=2**64": (f"whitted.render(SCENE, threads={HUGE})", "TypeError"),
+    "render with threads=None": ("whitted.render(SCENE, threads=None)", "TypeError"),
+    "render of None": ("whitted.render(None)", "TypeError"),
     "render_layers with threads=10**7": ("whitted.render_layers(SCENE, ['diffuse'], threads=10**7)", "ValueError"),
+    "render_layers with an unknown layer": ("whitted.render_layers(SCENE, ['nope'])", "Error"),
+    "render_layers with an empty layer name": ("whitted.render_layers(SCENE, [''])", "Error"),
+    "render_layers with layers=[None]": ("whitted.render_layers(SCENE, [None])", "TypeError"),
+    "load a missing scene": ("whitted.load(OUT + '/missing.yaml')", "Error"),
+    "load an empty path": ("whitted.load('')", "Error"),
+    "load a folder": ("whitted.load(OUT)", "Error"),
+    "load None": ("whitted.load(None)", "TypeError"),
+    "load with width=NaN": (f"whitted.load(SHADOWS, width={NAN})", "TypeError"),
+    "load with width=2**64": (f"whitted.load(SHADOWS, width={HUGE})", "TypeError"),
+    "load a path with a NUL": ("whitted.load(SHADOWS + '\\0.nff')", "ValueError"),
+    "write_povray to an empty path": ("whitted.write_povray(SCENE, '')", "Error"),
+    "write_povray into /proc": ("whitted.write_povray(SCENE, '/proc/x.pov')", "Error"),
+    "write_povray into a missing folder": ("whitted.write_povray(SCENE, OUT + '/no/x.pov')", "Error"),
     "check with threads=-5": ("whitted.check(SHADOWS, threads=-5)", "ValueError"),
+    "check a missing scene": ("whitted.check(OUT + '/missing.yaml')", "Error"),
+    "check an empty path": ("whitted.check('')", "Error"),
+    "check None": ("whitted.check(None)", "TypeError"),
+    "check with an unknown layer": ("whitted.check(SHADOWS, layers=['nope'])", "Error"),
+    "check with layers=None": ("whitted.check(SHADOWS, layers=None)", "TypeError"),
+    "check with a missing POV-Ray image": ("whitted.check(SHADOWS, povray_image=OUT + '/missing.png')", "Error"),
+    "check with a POV-Ray image that is text": ("whitted.check(SHADOWS, povray_image=TEXT)", "Error"),
+    "check with exposure=NaN": (f"whitted.check(SHADOWS, povray_image=TEXT, exposure={NAN})", "ValueError"),
+    "check with exposure=2": ("whitted.check(SHADOWS, povray_image=TEXT, exposure=2)", "ValueError"),
+    "check with exposure=0": ("whitted.check(SHADOWS, povray_image=TEXT, exposure=0)", "ValueError"),
+    "check with tolerance=NaN": (f"whitted.check(SHADOWS, tolerance={NAN})", "ValueError"),
+    "check with min_fraction=1.5": ("whitted.check(SHADOWS, min_fraction=1.5)", "ValueError"),
+    "check with max_error=-1": ("whitted.check(SHADOWS, max_error=-1)", "ValueError"),
+    "check with a report folder in /proc": ("whitted.check(SHADOWS, report_dir='/proc/whitted-report')", "Error"),
+    "check with a report path with a NUL": ("whitted.check(SHADOWS, report_dir=OUT + '/r\\0')", "ValueError"),
+    "compare_image_files of a missing file": ("whitted.compare_image_files(EXR, OUT + '/missing.exr')", "Error"),
+    "compare_image_files of empty paths": ("whitted.compare_image_files('', '')", "Error"),
+    "compare_image_files of a text file": ("whitted.compare_image_files(TEXT, EXR)", "Error"),
+    "compare_image_files of a folder": ("whitted.compare_image_files(EXR, OUT)", "Error"),
+    "compare_image_files of None": ("whitted.compare_image_files(None, EXR)", "TypeError"),
+    "compare_image_files of a number": ("whitted.compare_image_files(EXR, 5)", "TypeError"),
+    "compare_image_files with tolerance=NaN": (f"whitted.compare_image_files(EXR, EXR, tolerance={NAN})", "ValueError"),
+    "compare_image_files with tolerance=-1": ("whitted.compare_image_files(EXR, EXR, tolerance=-1)", "ValueError"),
+    "compare_image_files with tolerance=10**400": ("whitted.compare_image_files(EXR, EXR, tolerance=10**400)",
+                                                   "TypeError"),
+    "compare_image_files with min_fraction=NaN": (f"whitted.compare_image_files(EXR, EXR, min_fraction={NAN})",
+                                                  "ValueError"),
+    "compare_image_files with min_fraction=-0.5": ("whitted.compare_image_files(EXR, EXR, min_fraction=-0.5)",
+                                                   "ValueError"),
+    "compare_image_files with max_error=NaN": (f"whitted.compare_image_files(EXR, EXR, max_error={NAN})",
+                                               "ValueError"),
+    "compare_image_files with a NUL": ("whitted.compare_image_files(EXR + '\\0', EXR)", "ValueError"),
+    "explain a pixel left of the image": ("whitted.explain(SCENE, -1, 0)", "Error"),
+    "explain a pixel below the image": ("whitted.explain(SCENE, 0, SCENE.height)", "Error"),
+    "explain a pixel at 2**31-1": ("whitted.explain(SCENE, 2**31 - 1, 0)", "Error"),
+    "explain a pixel at 2**64": (f"whitted.explain(SCENE, {HUGE}, 0)", "TypeError"),
+    "explain a pixel at NaN": (f"whitted.explain(SCENE, {NAN}, 0)", "TypeError"),
+    "explain a pixel of None": ("whitted.explain(SCENE, None, 0)", "TypeError"),
+    "explain None": ("whitted.explain(None, 0, 0)", "TypeError"),
+    "explain with threads=-1": ("whitted.explain(SCENE, 0, 0, threads=-1)", "ValueError"),
+    "explain_text a pixel outside": ("whitted.explain_text(SCENE, SCENE.width, 0, summary=True)", "Error"),
+    "explain_text with summary='yes'": ("whitted.explain_text(SCENE, 0, 0, summary='yes')", "TypeError"),
+    "describe_colour_config of a missing config": ("whitted.describe_colour_config(OUT + '/missing.ocio')", "Error"),
+    "describe_colour_config of a folder": ("whitted.describe_colour_config(OUT)", "Error"),
+    "describe_colour_config of a text file": ("whitted.describe_colour_config(TEXT)", "Error"),
+    "describe_colour_config of None": ("whitted.describe_colour_config(None)", "TypeError"),
+    "describe_colour_config with a NUL": ("whitted.describe_colour_config(OUT + '\\0')", "ValueError"),
+    "write_colour_config into a missing folder": ("whitted.write_colour_config(OUT + '/no/such/x.ocio')", "Error"),
+    "write_colour_config through a symlink": ("whitted.write_colour_config(LINK)", "Error"),
+    "write_colour_config onto a folder": ("whitted.write_colour_config(OUT)", "Error"),
+    "write_colour_config to /dev/full": ("whitted.write_colour_config('/dev/full')", "Error"),
+    "write_colour_config into /proc": ("whitted.write_colour_config('/proc/whitted.ocio')", "Error"),
+    "write_colour_config to an empty path": ("whitted.write_colour_config('')", "Error"),
+    "write_colour_config to None": ("whitted.write_colour_config(None)", "TypeError"),
+    "write_colour_config to a number": ("whitted.write_colour_config(3)", "TypeError"),
+    "write_colour_config with a NUL": ("whitted.write_colour_config(OUT + '/c.ocio\\0.txt')", "ValueError"),
 }
 
 
-@pytest.mark.parametrize("case", sorted(ERROR_PATHS))
-def test_every_error_path_raises(case, tmp_path):
-    call, expected = ERROR_PATHS[case]
-    program = textwrap.dedent(f"""
-        import numpy as np, whitted
-        OUT = {str(tmp_path)!r}
-        SHADOWS = {SHADOWS!r}
-        SCENE = whitted.load(SHADOWS)
-        try:
-            {call}
-        except Exception as e:
-            print(type(e).__name__, isinstance(e, RuntimeError) if type(e).__name__ == 'Error' else '', e)
-        else:
-            print('NOTHING RAISED')
-    """)
-    result = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True, timeout=120,
+@pytest.fixture(scope="module")
+def error_path_outcomes(tmp_path_factory):
+    """{case: (exception type name, is a RuntimeError, message)}; runs every case of ERROR_PATHS
+    in one child python3, and checks what they left behind."""
+    out = tmp_path_factory.mktemp("error_paths")
+    elsewhere = tmp_path_factory.mktemp("elsewhere")
+    victim = elsewhere / "victim.txt"
+    victim.write_text("precious: written through a symbolic link if this changes\n")
+    os.symlink(victim, out / "link")
+    os.symlink(victim, out / "link.exr")
+    (out / "text.png").write_text("not an image\n")
+    lines = ["import numpy as np, sys, whitted",
+             f"OUT, SHADOWS = {str(out)!r}, {SHADOWS!r}",
+             "LINK, TEXT, EXR = OUT + '/link', OUT + '/text.png', OUT + '/two.exr'",
+             "SCENE = whitted.load(SHADOWS)",
+             "whitted.write_image(np.ones((2, 2, 3), np.float32), EXR)",
+             "def run(case, call):",
+             "    print('CASE', case, flush=True)",
+             "    try:",
+             "        call()",
+             "    except Exception as e:",
+             "        print('RAISED', type(e).__name__, isinstance(e, RuntimeError), str(e).replace(chr(10), ' '), flush=True)",
+             "    else:",
+             "        print('RAISED NOTHING', flush=True)"]
+    for case, (call, _) in ERROR_PATHS.items():
+        lines.append(f"run({case!r}, lambda: {call})")
+    result = subprocess.run([sys.executable, "-c", "\n".join(lines)], capture_output=True, text=True, timeout=300,
                             env=child_python_env())
-    assert result.returncode == 0, f"{case}: exit {result.returncode}\n{result.stderr[-2000:]}"
-    kind = result.stdout.split()[0] if result.stdout.split() else ""
-    assert kind == expected, f"{case}: {result.stdout}{result.stderr[-2000:]}"
-    if expected == "Error":
-        assert result.stdout.split()[1] == "True", "whitted.Error is a RuntimeError"
+    outcomes, case = {}, None
+    for line in result.stdout.splitlines():
+        if line.startswith("CASE "):
+            case = line[5:]
+        elif line.startswith("RAISED ") and case:
+            kind, _, rest = line[7:].partition(" ")
+            is_runtime, _, message = rest.partition(" ")
+            outcomes[case] = (kind, is_runtime == "True", message)
+            case = None
+    if case is not None:  # the child died in the middle of this case
+        outcomes[case] = (f"CRASHED (exit {result.returncode}): {result.stderr[-1500:]}", False, "")
+    assert victim.read_text() == "precious: written through a symbolic link if this changes\n"
+    assert os.path.islink(out / "link") and not os.path.islink(out / "link.exr")
     # Nothing half-written is left behind.
-    assert not [p for p in os.listdir(tmp_path) if "tmp" in p], os.listdir(tmp_path)
+    leftovers = [p for p in os.listdir(out) if p not in ("link", "link.exr", "text.png", "two.exr")]
+    assert leftovers == [], leftovers
+    return outcomes
+
+
+@pytest.mark.parametrize("case", sorted(ERROR_PATHS))
+def test_every_error_path_raises(case, error_path_outcomes):
+    _, expected = ERROR_PATHS[case]
+    assert case in error_path_outcomes, f"{case}: never ran (an earlier case ended the interpreter?)"
+    kind, is_runtime, message = error_path_outcomes[case]
+    assert kind == expected, f"{case}: {kind} {message}"
+    if expected == "Error":
+        assert is_runtime, "whitted.Error is a RuntimeError"
+        assert message, f"{case}: an Error with no message"
 
 
 def test_overrides_act_as_the_files_own_settings():
@@ -385,3 +501,170 @@ def test_a_material_colour_may_be_one_number_for_a_grey_and_nothing_else():
     for bad in ("red", [1, 2], None):
         with pytest.raises(ValueError, match="kd must be a number or three numbers"):
             pixel(bad)
+
+
+def run_whitted(*args, expect=0):
+    result = subprocess.run([WHITTED, *args], capture_output=True, text=True, timeout=120)
+    assert result.returncode == expect, (args, result.returncode, result.stderr)
+    return result
+
+
+def test_explain_is_the_programs_explain():
+    scene = whitted.load(SHADOWS)
+    image = whitted.render(scene, threads=2)
+    lit = np.unravel_index(np.argmax(image.sum(axis=2)), image.shape[:2])
+    # The brightest pixel (every term of the slide at work) and one of the background.
+    for y, x in [tuple(int(v) for v in lit), (0, 0)]:
+        pixel = f"{x},{y}"
+        document = whitted.explain(scene, x, y, threads=1)
+        assert (document["x"], document["y"], document["width"]) == (x, y, scene.width)
+        np.testing.assert_allclose(document["rgb"], image[y, x], rtol=1e-6)
+        assert document == json.loads(run_whitted("explain", SHADOWS, "--pixel", pixel, "--json", "-t", "1").stdout)
+        assert whitted.explain_text(scene, x, y) == run_whitted("explain", SHADOWS, "--pixel", pixel).stdout
+        assert whitted.explain_text(scene, x, y, summary=True) == run_whitted(
+            "explain", SHADOWS, "--pixel", pixel, "--summary").stdout
+    assert max(image[lit]) > 0.1, "the brightest pixel is dark: the test proves little"
+
+
+def test_compare_image_files_is_the_programs_compare(tmp_path):
+    image = whitted.render(whitted.load(SHADOWS, width=64), threads=2)
+    first, png = str(tmp_path / "a.exr"), str(tmp_path / "a.png")
+    whitted.write_image(image, first)
+    whitted.write_image(image, png)
+    off = image.copy()
+    off[3, 5] += 0.01  # 655 codes: breaks the cap, not the share
+    whitted.write_image(off, str(tmp_path / "off.exr"))
+    whitted.write_image(image[:10], str(tmp_path / "short.exr"))
+    cases = [(first, first, {}, []), (first, str(tmp_path / "off.exr"), {}, []),
+             (first, str(tmp_path / "off.exr"), {"max_error": 1000.0}, ["--max-error", "1000"]),
+             (first, png, {"clip": True}, ["--clip"]),
+             (first, png, {"tolerance": 300.0, "min_fraction": 0.5, "max_error": 1000.0, "clip": True},
+              ["--tolerance", "300", "--min-fraction", "0.5", "--max-error", "1000", "--clip"]),
+             (first, str(tmp_path / "short.exr"), {}, [])]
+    verdicts = []
+    for index, (a, b, keywords, flags) in enumerate(cases):
+        compared = whitted.compare_image_files(a, b, **keywords)
+        if index in (1, 4, 5):  # the program once for a failure, a pass and a size mismatch
+            cli = run_whitted("compare", a, b, *flags, expect=0 if compared.passed else 1)
+            lines = cli.stdout.splitlines()
+            assert lines[-1] == compared.verdict
+            if compared.first_meaning:
+                assert lines[:2] == [f"{a}: {compared.first_meaning}", f"{b}: {compared.second_meaning}"]
+        assert bool(compared) == compared.passed and compared.passed == (compared.failures == [])
+        verdicts.append(compared.passed)
+    assert verdicts == [True, False, True, False, True, False], verdicts
+    off_by = whitted.compare_image_files(first, str(tmp_path / "off.exr"))
+    assert off_by.failures == [f for f in off_by.failures if f.startswith("cap")] and off_by.failures
+    assert 600 < off_by.max_error_codes < 700 and off_by.fraction_within > 0.999 and off_by.rms_error > 0
+    # Images of different sizes are a result that names the sizes, not an exception.
+    short = whitted.compare_image_files(first, str(tmp_path / "short.exr"))
+    assert short.first_meaning == "" and any("size" in f for f in short.failures), short.failures
+
+
+def test_colour_config_is_the_programs_colour(tmp_path):
+    assert whitted.describe_colour_config() == run_whitted("colour", "--list").stdout
+    ours, theirs = tmp_path / "ours.ocio", tmp_path / "theirs.ocio"
+    assert whitted.write_colour_config(str(ours)) is None
+    run_whitted("colour", "--write-config", str(theirs))
+    assert ours.read_bytes() == theirs.read_bytes() and b"displays" in ours.read_bytes()
+    assert whitted.describe_colour_config(str(ours)) == run_whitted(
+        "colour", "--list", "--ocio-config", str(ours)).stdout
+    # An existing file is replaced by a complete one.
+    ours.write_text("old\n")
+    whitted.write_colour_config(str(ours))
+    assert ours.read_bytes() == theirs.read_bytes()
+
+
+def test_a_failed_write_leaves_an_existing_output_as_it_was(tmp_path):
+    existing = tmp_path / "kept.png"
+    existing.write_bytes(b"an earlier image\n")
+    with pytest.raises(whitted.Error, match="Nope"):
+        whitted.write_image(np.zeros((2, 2, 3), np.float32), str(existing), display="Nope")
+    with pytest.raises(whitted.Error, match="symbolic link"):
+        os.symlink(existing, tmp_path / "link.ocio")
+        whitted.write_colour_config(str(tmp_path / "link.ocio"))
+    assert existing.read_bytes() == b"an earlier image\n"
+    assert sorted(os.listdir(tmp_path)) == ["kept.png", "link.ocio"]
+
+
+def test_check_errors_name_the_file_and_the_kind(tmp_path):
+    with pytest.raises(whitted.Error) as raised:
+        whitted.check(str(tmp_path / "missing.yaml"))
+    assert raised.value.kind == "bad_input" and "not found" in str(raised.value)
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("version: 1\ncamera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\nimage: {width: 8, height: -4}\n")
+    with pytest.raises(whitted.Error, match=rf"^{bad}:3:\d+: ") as raised:
+        whitted.check(str(bad))
+    assert raised.value.line == 3 and raised.value.kind == "bad_input"
+
+
+def test_check_with_a_stored_povray_image_and_layers(tmp_path, capfd):
+    """check(povray_image=...) compares with a stored image instead of running POV-Ray, written
+    here with tests/validation's 16-bit PNG writer (every pixel the scene's background)."""
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "validation"))
+    scene = tmp_path / "empty.yaml"
+    scene.write_text("version: 1\ncamera: { eye: [0, 0, 5], look_at: [0, 0, 0] }\n"
+                     "image: { width: 16, height: 12, background: [0.5, 0.25, 0.125] }\n"
+                     "lights: []\nmaterials: {}\nobjects: []\n")
+    import images
+    stored, black = str(tmp_path / "povray.png"), str(tmp_path / "black.png")
+    images.png16(stored, 16, 12, [32768, 16384, 8192], {}, 3)  # the background in 16-bit codes
+    images.png16(black, 16, 12, [0, 0, 0], {}, 3)
+    passed = whitted.check(str(scene), povray_image=stored, layers=["diffuse", "background"])
+    assert passed and passed.verdict.startswith("PASS"), passed.verdict
+    assert passed.verdict in capfd.readouterr().out
+    cli = subprocess.run([WHITTED, "check", str(scene), "-q", "--povray-image", stored, "--layers", "diffuse,background"],
+                         capture_output=True, text=True, timeout=120)
+    assert cli.returncode == 0 and cli.stdout.splitlines()[-1] == passed.verdict
+    # A stored image of another colour fails: a result, not an exception.
+    failed = whitted.check(str(scene), povray_image=black)
+    assert not failed and failed.verdict.startswith("FAIL") and failed.failures, failed.verdict
+
+
+def test_ctrl_c_cancels_a_check_and_ends_povray(tmp_path):
+    """SIGINT while POV-Ray runs (a stand-in that hangs): KeyboardInterrupt within 5 s, POV-Ray
+    ended, and nothing of the check's left in $TMPDIR."""
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "validation"))
+    import fake_povray
+    scene = tmp_path / "empty.yaml"
+    scene.write_text("version: 1\ncamera: { eye: [0, 0, 5], look_at: [0, 0, 0] }\n"
+                     "image: { width: 16, height: 12 }\nlights: []\nmaterials: {}\nobjects: []\n")
+    private_tmp, pidfile = tmp_path / "tmp", tmp_path / "povray.pid"
+    private_tmp.mkdir()
+    env = dict(child_python_env(), WHITTED_POVRAY=fake_povray.install(str(tmp_path)), FAKE_POVRAY_MODE="hang",
+               FAKE_POVRAY_PIDFILE=str(pidfile), TMPDIR=str(private_tmp))
+    script = textwrap.dedent(f"""
+        import sys
+        sys.path.insert(0, {os.path.dirname(whitted.__file__)!r})
+        import whitted
+        try:
+            whitted.check({str(scene)!r})
+        except KeyboardInterrupt:
+            print("interrupted", flush=True)
+            sys.exit(42)
+        print("finished", flush=True)
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=env)
+    deadline = time.monotonic() + 60
+    while not pidfile.exists():
+        assert proc.poll() is None and time.monotonic() < deadline, "POV-Ray never started"
+        time.sleep(0.05)
+    povray_pid = int(pidfile.read_text())
+    sent = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    try:
+        out, _ = proc.communicate(timeout=30)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        os.kill(povray_pid, signal.SIGKILL)
+        raise
+    took = time.monotonic() - sent
+    assert out.strip() == "interrupted" and proc.returncode == 42, (out, proc.returncode)
+    assert took < 5, f"the check stopped {took:.1f} s after SIGINT"
+    try:
+        os.kill(povray_pid, 0)
+        alive = not open(f"/proc/{povray_pid}/stat").read().split()[2] == "Z"
+    except ProcessLookupError:
+        alive = False
+    assert not alive, "POV-Ray is still running"
+    assert os.listdir(private_tmp) == [], os.listdir(private_tmp)
