@@ -39,7 +39,8 @@ async function settled(page) {
             return Object.assign({}, t, {input: window.benchInput, fullShownSinceInput: t.start + t.fullShown - window.benchInput,
                                          // not shown when the server took the preview first
                                          coarseShownSinceInput: t.coarseShown ? t.start + t.coarseShown - window.benchInput : null,
-                                         previewShownSinceInput: t.start + t.previewShown - window.benchInput});
+                                         // none when the full image was shaded again at once
+                                         previewShownSinceInput: t.previewShown ? t.start + t.previewShown - window.benchInput : null});
         });
         samples.push(sample);
     }

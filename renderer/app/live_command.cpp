@@ -10,6 +10,8 @@
 #include "api/api_internal.h"
 #include "converters/yaml_writer.h"
 #include "live_page_html.h"
+#include "render/accelerator.h"
+#include "render/reshade.h"
 #include "scene/description.h"
 #include "scene/errors.h"
 #include "scene/scene.h"
@@ -357,6 +359,7 @@ struct Rendered {
     std::string bytes;
     double render_seconds = 0, encode_seconds = 0;
 };
+Rendered encode_image(const Image& shown, const api::WriteOptions& write, const std::filesystem::path& temp_file);
 
 Rendered render_image(SceneDescription description, const std::string& view, const std::string& level, int threads,
                       const std::filesystem::path& temp_file) {
@@ -399,6 +402,13 @@ Rendered render_image(SceneDescription description, const std::string& view, con
             throw std::runtime_error("the render has no layer " + view);
     }
     if (exr) write.view.clear();
+    Rendered rendered = encode_image(shown, write, temp_file);
+    rendered.render_seconds = result->stats.seconds;
+    return rendered;
+}
+
+/// `shown` written as `temp_file` says (PNG or EXR) and read back.
+Rendered encode_image(const Image& shown, const api::WriteOptions& write, const std::filesystem::path& temp_file) {
     const auto encode_start = std::chrono::steady_clock::now();
     if (const auto written = api::write_image(shown, temp_file.string(), write); !written)
         throw std::runtime_error(written.error().what());
@@ -412,8 +422,62 @@ Rendered render_image(SceneDescription description, const std::string& view, con
     rendered.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - encode_start).count();
     std::error_code ignored;
     std::filesystem::remove(temp_file, ignored);
-    rendered.render_seconds = result->stats.seconds;
     return rendered;
+}
+
+/// The page's values without those re-shading covers (each material's ka, kd, ks, p, km and
+/// each light's intensity): two requests with the same file version and the same rest have the
+/// same rays, hits and shadow rays.
+std::string geometry_key(uint64_t version, json values) {
+    if (const auto materials = values.find("materials"); materials != values.end() && materials->is_object())
+        for (auto& [name, fields] : materials->items())
+            if (fields.is_object())
+                for (const char* field : {"ka", "kd", "ks", "p", "km"}) fields.erase(field);
+    if (const auto lights = values.find("lights"); lights != values.end() && lights->is_array())
+        for (json& light : *lights)
+            if (light.is_object()) light.erase("intensity");
+    // What is left empty says nothing: {"materials": {"shiny": {}}} is {}.
+    if (const auto materials = values.find("materials"); materials != values.end() && materials->is_object()) {
+        for (auto entry = materials->begin(); entry != materials->end();)
+            entry = entry->is_object() && entry->empty() ? materials->erase(entry) : std::next(entry);
+        if (materials->empty()) values.erase("materials");
+    }
+    if (const auto lights = values.find("lights"); lights != values.end() && lights->is_array()) {
+        for (json& light : *lights)
+            if (light.is_object() && light.empty()) light = nullptr;
+        while (!lights->empty() && lights->back().is_null()) lights->erase(lights->end() - 1);
+        if (lights->empty()) values.erase("lights");
+    }
+    return std::to_string(version) + "\n" + values.dump();
+}
+
+/// The beauty's full image through the shading cache (render/reshade.h): re-shaded from the last
+/// full render's paths when only what re-shading covers changed, else rendered (with `level`
+/// "reshade": nothing, `reshaded` false and no image) and recorded for the next change.
+struct LiveShadingCache {
+    std::string key;
+    ShadingCache cache;
+};
+struct Beauty {
+    Image image;
+    bool reshaded = false;
+    double seconds = 0;
+};
+Beauty full_beauty(const SceneDescription& description, const std::string& key, bool reshade_only, int threads,
+                   LiveShadingCache& cached) {
+    const Scene scene = validate_scene(description);
+    Beauty beauty;
+    const auto start = std::chrono::steady_clock::now();
+    if (cached.key == key && cached.cache.reshade(scene, threads, beauty.image)) {
+        beauty.reshaded = true;
+    } else if (!reshade_only) {
+        cached = LiveShadingCache();  // the old cache's memory goes before the new one's comes
+        const Accelerator accelerator(scene, threads);
+        cached.cache = ShadingCache::record(scene, accelerator, threads, beauty.image);
+        cached.key = key;
+    }
+    beauty.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return beauty;
 }
 
 /// Where the page asks to save: a .yaml or .yml path, relative ones beside the scene file.
@@ -538,6 +602,7 @@ int run_live(const LiveArguments& args) {
     // and both be late.
     std::mutex render_mutex;
     uint64_t render_count = 0, check_count = 0;
+    LiveShadingCache shading_cache;  // the last full beauty's paths; under render_mutex
     // A POST whose body is a JSON object about the file as it loads now, with its errors sent
     // as 400 (the page's request), 422 (the scene refuses the values), 409 (the file does not
     // load) or 500.
@@ -569,14 +634,31 @@ int run_live(const LiveArguments& args) {
 
     post("/render", [&](const json& body, const LiveState::Snapshot& snapshot, httplib::Response& response) {
         const std::string level = string_member(body, "level", "full"), format = string_member(body, "format", "png");
-        if ((level != "full" && level != "preview" && level != "coarse") || (format != "png" && format != "exr"))
-            throw BadRequest("level must be full, preview or coarse, format png or exr");
+        if ((level != "full" && level != "preview" && level != "coarse" && level != "reshade") ||
+            (format != "png" && format != "exr"))
+            throw BadRequest("level must be full, preview, coarse or reshade, format png or exr");
         const std::string view = string_member(body, "view", "beauty");
+        if (level == "reshade" && view != "beauty") throw BadRequest("level reshade: only the beauty is re-shaded");
         std::lock_guard lock(render_mutex);
         const std::filesystem::path file = temp_dir / ("render-" + std::to_string(++render_count) + "." + format);
         const auto start = std::chrono::steady_clock::now();
-        const Rendered rendered = render_image(edited_description(snapshot.text, state.path(), values_of(body)), view,
-                                               level, args.threads, file);
+        SceneDescription description = edited_description(snapshot.text, state.path(), values_of(body));
+        Rendered rendered;
+        if (view == "beauty" && (level == "full" || level == "reshade")) {
+            Beauty beauty = full_beauty(description, geometry_key(snapshot.version, values_of(body)),
+                                        level == "reshade", args.threads, shading_cache);
+            response.set_header("X-Whitted-Reshaded", beauty.reshaded ? "1" : "0");
+            if (level == "reshade" && !beauty.reshaded) {
+                response.status = 204;  // the cache does not cover these values: render them
+                return;
+            }
+            api::WriteOptions write;
+            if (format == "exr") write.view.clear();
+            rendered = encode_image(beauty.image, write, file);
+            rendered.render_seconds = beauty.seconds;
+        } else {
+            rendered = render_image(std::move(description), view, level, args.threads, file);
+        }
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         response.set_header("X-Whitted-Version", std::to_string(snapshot.version));
         response.set_header("X-Whitted-Render-Ms", std::to_string(int(rendered.render_seconds * 1000 + 0.5)));

@@ -191,6 +191,22 @@ def main():
     check(not np.array_equal(page_png, pixels(os.path.join(work, "original.png"))),
           "and differs from the render of the unedited file (the comparison can fail)")
 
+    # After a light moved (the server rendered: its shading cache does not cover a light's
+    # position) the page's PNG is `whitted render`'s of those values too.
+    moved_values = json.load(open(os.path.join(work, "values-moved.json")))
+    moved = yaml.safe_load(original)
+    for i, light in enumerate(moved_values.get("lights", [])):
+        if light:
+            moved["lights"][i].update(light)
+    with open(os.path.join(work, "edited-moved.yaml"), "w") as f:
+        yaml.safe_dump(moved, f, sort_keys=False)
+    r = subprocess.run([whitted, "render", os.path.join(work, "edited-moved.yaml"), "-q", "-o",
+                        os.path.join(work, "edited-moved.png")])
+    moved_png = pixels(os.path.join(work, "page-moved.png"))
+    check(r.returncode == 0 and np.array_equal(moved_png, pixels(os.path.join(work, "edited-moved.png")))
+          and not np.array_equal(moved_png, pixels(os.path.join(work, "original.png"))),
+          "after the light moved, the page's PNG equals `whitted render` of those values pixel for pixel")
+
     # The saved file renders to the image the page showed: whitted render, bit for bit.
     saved = os.path.join(work, "saved.yaml")
     # (The page's PNG is the edited file's, above: the same EXR gives the same PNG.)

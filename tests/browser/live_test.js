@@ -78,6 +78,9 @@ async function settled(page, timeout) {
     check(!after.equals(before), "the image changed after the slider moved");
     const timings = await page.evaluate(() => whittedLive.timings);
     const last = timings[timings.length - 1];
+    // Only kd moved: the server shades the full image again from the first render's hits
+    // (live_browser.py compares that image with `whitted render` of the edited file).
+    check(last.reshaded === true, "the kd move's full image was shaded again from the last render's hits");
     console.log(`timing: coarse image shown ${last.coarseShown.toFixed(0)} ms after the change (render ${last.coarseRender} ms), ` +
                 `full image ${last.fullShown.toFixed(0)} ms (render ${last.fullRender} ms)`);
     fs.writeFileSync(path.join(work, "values.json"), JSON.stringify(values));
@@ -184,6 +187,20 @@ async function settled(page, timeout) {
     check(await page.locator("#image").isVisible(), "the image is back once the file loads again");
     check((await shownPng(page)).equals(before), "and it is the file's own image again");
     check((await page.locator("#explain").evaluate((e) => e.classList.contains("stale"))), "the explanation of the edited values is dimmed now");
+
+    // 5. A light moved: its shadow rays change, so the server cannot shade again and renders
+    // (live_browser.py compares this image with `whitted render` of the edited file too).
+    const lightSlider = page.locator("#l0-position-0");
+    await lightSlider.focus();
+    await page.keyboard.press("ArrowRight");
+    await settled(page, 60000);
+    const movedTimings = await page.evaluate(() => whittedLive.timings);
+    check(movedTimings[movedTimings.length - 1].reshaded === false, "the light's move was rendered, not shaded again");
+    const movedValues = await page.evaluate(() => whittedLive.shown);
+    check(movedValues.lights && movedValues.lights[0] && Array.isArray(movedValues.lights[0].position),
+          `the light's position is among the values: ${JSON.stringify(movedValues)}`);
+    fs.writeFileSync(path.join(work, "values-moved.json"), JSON.stringify(movedValues));
+    fs.writeFileSync(path.join(work, "page-moved.png"), await shownPng(page));
 
     // The server's two refusals of the save over the existing file (409, before the page asked)
     // are logged by Chromium as failed loads: expected, and only those.
