@@ -40,17 +40,6 @@ Error plain_error(std::string message, Error::Kind kind) {
     return error;
 }
 
-/// Runs `work`, turning what it throws into an Error (scene/errors.h); `what` finishes "out of
-/// memory while ...".
-template <class T, class Work>
-Expected<T> guarded(const std::string& what, Work&& work) {
-    try {
-        return work();
-    } catch (...) {
-        return current_error({what});
-    }
-}
-
 /// `read` fills the description and the validated scene of a new Scene::Impl. An error without
 /// a place names `label`; one reading a file (a filesystem error) is the caller's input.
 Expected<Scene> load(const std::string& label, const std::function<void(Scene::Impl&)>& read) {

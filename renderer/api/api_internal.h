@@ -10,6 +10,7 @@
 #include "render/accelerator.h"
 #include "render/work_exchange.h"
 #include "scene/description.h"
+#include "scene/errors.h"
 #include "scene/scene.h"
 #include "scene/text_checks.h"
 #include "whitted/whitted.h"
@@ -46,6 +47,21 @@ OutputOptions output_options(const WriteOptions& options);
 
 /// The private side of a Scene, for the library's own functions.
 const Scene::Impl& impl_of(const Scene& scene);
+
+/// Runs `work`, turning what it throws into an Error by the one mapping (scene/errors.h).
+template <class T, class Work>
+Expected<T> guarded(const ErrorContext& context, Work&& work) {
+    try {
+        return work();
+    } catch (...) {
+        return current_error(context);
+    }
+}
+/// The same where the work is on input already accepted; `doing` finishes "out of memory while ...".
+template <class T, class Work>
+Expected<T> guarded(const std::string& doing, Work&& work) {
+    return guarded<T>(ErrorContext(doing), std::forward<Work>(work));
+}
 
 struct MpiJob::Impl {
     std::unique_ptr<WorkExchange> exchange;

@@ -88,13 +88,11 @@ const MpiJob::Impl& impl_of(const MpiJob& job) {
 }
 
 Expected<MpiJob> join_mpi_job() {
-    try {
+    return guarded<MpiJob>("starting MPI", [&]() -> Expected<MpiJob> {
         auto impl = std::make_unique<MpiJob::Impl>();
         impl->exchange = open_mpi_exchange();
         return MpiJob(std::move(impl));
-    } catch (...) {
-        return current_error({"starting MPI"});
-    }
+    });
 }
 
 // ---- render's usage checks ------------------------------------------------------------------
@@ -102,7 +100,7 @@ Expected<MpiJob> join_mpi_job() {
 Expected<void> check_image_output(const std::string& path, const WriteOptions& options,
                                   const std::vector<std::string>& layers, const std::string& layers_from,
                                   const std::string& input) {
-    try {
+    return guarded<void>({"checking " + input, input, Error::Kind::bad_input}, [&]() -> Expected<void> {
         check_output_path(path);
         OutputOptions output = output_options(options);
         if (!parse_layers(layers).empty()) output.layers_from = layers_from;
@@ -115,9 +113,7 @@ Expected<void> check_image_output(const std::string& path, const WriteOptions& o
                                         input + "'");
         refuse_symlink_target(path);
         return {};
-    } catch (...) {
-        return current_error({"checking " + input, input, Error::Kind::bad_input});
-    }
+    });
 }
 
 std::string layer_choices() {
@@ -125,22 +121,18 @@ std::string layer_choices() {
 }
 
 Expected<EmbreeInfo> embree_info() {
-    try {
+    return guarded<EmbreeInfo>("asking Embree", [&]() -> Expected<EmbreeInfo> {
         const std::string isa = embree_isa_from_environment();
         const whitted::EmbreeInfo info = whitted::embree_info(isa);
         return EmbreeInfo{info.version, info.isas, info.isa_in_use, !isa.empty(), info.lane_width};
-    } catch (...) {
-        return current_error({"asking Embree"});
-    }
+    });
 }
 
 Expected<void> check_embree_isa() {
-    try {
+    return guarded<void>({"checking WHITTED_EMBREE_ISA", "", Error::Kind::bad_input}, [&]() -> Expected<void> {
         require_embree_isa(embree_isa_from_environment());
         return {};
-    } catch (...) {
-        return current_error({"checking WHITTED_EMBREE_ISA", "", Error::Kind::bad_input});
-    }
+    });
 }
 
 std::string printable(const std::string& text, size_t max_characters) {
@@ -154,7 +146,7 @@ std::string did_you_mean(const std::string& word, const std::vector<std::string>
 // ---- convert --------------------------------------------------------------------------------
 
 Expected<void> check_convert_output(const std::string& output, const std::string& input) {
-    try {
+    return guarded<void>("converting " + input, [&]() -> Expected<void> {
         const ConvertTarget target = convert_target(output);
         if (!input.empty()) refuse_overwriting_input(output, input);
         check_can_write(output);
@@ -166,13 +158,12 @@ Expected<void> check_convert_output(const std::string& output, const std::string
         refuse_symlink_target(output);
         if (!target.yaml) refuse_symlink_target(target.ini);
         return {};
-    } catch (...) {
-        return current_error({"converting " + input});
-    }
+    });
 }
 
 Expected<std::vector<std::string>> convert(const Scene& scene, const std::string& output) {
-    try {
+    using Written = std::vector<std::string>;
+    return guarded<Written>("converting " + scene.path(), [&]() -> Expected<Written> {
         const ConvertTarget target = convert_target(output);
         const Scene::Impl& loaded = impl_of(scene);
         const SceneDescription& description = loaded.converter_description();
@@ -187,13 +178,11 @@ Expected<std::vector<std::string>> convert(const Scene& scene, const std::string
         if (target.yaml) {
             // Any scene Whitted reads (a course .xml file, say) in Whitted's own format.
             yaml::write_yaml_file(description, output);
-            return std::vector<std::string>{output};
+            return Written{output};
         }
         const std::string ini = pov::write_pov_files(description, loaded.scene, output);
-        return std::vector<std::string>{output, ini};
-    } catch (...) {
-        return current_error({"converting " + scene.path()});
-    }
+        return Written{output, ini};
+    });
 }
 
 }  // namespace whitted::api
