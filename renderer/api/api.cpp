@@ -40,24 +40,15 @@ Error plain_error(std::string message, Error::Kind kind) {
     return error;
 }
 
-/// Runs `work`, turning what it throws into an Error (scene/errors.h); `what` finishes "out of
-/// memory while ...".
-template <class T, class Work>
-Expected<T> guarded(const std::string& what, Work&& work) {
-    try {
-        return work();
-    } catch (...) {
-        return current_error({what});
-    }
-}
-
 /// `read` fills the description and the validated scene of a new Scene::Impl. An error without
 /// a place names `label`; one reading a file (a filesystem error) is the caller's input.
 Expected<Scene> load(const std::string& label, const std::function<void(Scene::Impl&)>& read) {
     try {
         auto impl = std::make_unique<Scene::Impl>();
         const auto start = clock::now();
+        const InputFilesNoted noting;  // the scene file, its meshes and MTL files, as they are read
         read(*impl);
+        impl->inputs = noting.noted();
         impl->read_seconds = seconds_since(start);
         return Scene(std::move(impl));
     } catch (...) {
@@ -222,6 +213,9 @@ SceneCounts Scene::counts() const {
 }
 double Scene::read_seconds() const {
     return m_impl->read_seconds;
+}
+std::string Scene::input_file_at(const std::string& path) const {
+    return whitted::input_file_at(path, m_impl->inputs);
 }
 const Scene::Impl& impl_of(const Scene& scene) {
     return *scene.m_impl;
@@ -451,11 +445,8 @@ Expected<AcceleratorInfo> prepare(const Scene& scene, int threads) {
 }
 
 Expected<RenderResult> render(const Scene& scene, const RenderOptions& options) {
-    return render_distributed(scene, options, nullptr);
-}
-
-Expected<RenderResult> render_distributed(const Scene& scene, const RenderOptions& options, WorkExchange* exchange) {
     return guarded<RenderResult>("rendering " + scene.path(), [&]() -> Expected<RenderResult> {
+        WorkExchange* const exchange = options.mpi_job ? impl_of(*options.mpi_job).exchange.get() : nullptr;
         whitted::RenderedTiles internal = render_internal(scene, options, layers_for(scene, options), exchange);
         RenderResult result;
         result.image = std::move(internal.image);

@@ -2,15 +2,17 @@
 #pragma once
 
 // The library's private side of whitted::api::Scene: the parsed description (the converters read
-// it) and the validated render Scene, with the BVH built once on demand. Only the library (and the
-// `whitted` program's `live`, which renders a description it edits, and `render` under MPI)
-// include this; the public headers never do.
+// it) and the validated render Scene, with the BVH built once on demand; and of api::MpiJob. Only
+// the library (and `whitted live`, which renders a description it edits) include this; the
+// public headers never do.
 
 #include "output/image_output.h"
 #include "render/accelerator.h"
 #include "render/work_exchange.h"
 #include "scene/description.h"
+#include "scene/errors.h"
 #include "scene/scene.h"
+#include "scene/text_checks.h"
 #include "whitted/whitted.h"
 
 #include <memory>
@@ -24,7 +26,8 @@ struct Scene::Impl {
     SceneDescription description;
     bool objects_kept = true;
     whitted::Scene scene;
-    double read_seconds = 0;  ///< load_scene_*: reading, validating and loading meshes, wall time
+    double read_seconds = 0;         ///< load_scene_*: reading, validating and loading meshes, wall time
+    std::vector<NotedInput> inputs;  ///< the files read to load it (Scene::input_file_at)
 
     /// The whole description, for the converters; throws std::invalid_argument without its objects.
     const SceneDescription& converter_description() const;
@@ -45,9 +48,25 @@ OutputOptions output_options(const WriteOptions& options);
 /// The private side of a Scene, for the library's own functions.
 const Scene::Impl& impl_of(const Scene& scene);
 
-/// api::render with the tiles shared among MPI ranks through `exchange` (null: one process), for
-/// `whitted render` under mpirun (docs/distributed.md); not in the public API yet. On a rank other
-/// than 0 the image holds only the tiles that rank rendered.
-Expected<RenderResult> render_distributed(const Scene& scene, const RenderOptions& options, WorkExchange* exchange);
+/// Runs `work`, turning what it throws into an Error by the one mapping (scene/errors.h).
+template <class T, class Work>
+Expected<T> guarded(const ErrorContext& context, Work&& work) {
+    try {
+        return work();
+    } catch (...) {
+        return current_error(context);
+    }
+}
+/// The same where the work is on input already accepted; `doing` finishes "out of memory while ...".
+template <class T, class Work>
+Expected<T> guarded(const std::string& doing, Work&& work) {
+    return guarded<T>(ErrorContext(doing), std::forward<Work>(work));
+}
+
+struct MpiJob::Impl {
+    std::unique_ptr<WorkExchange> exchange;
+};
+
+const MpiJob::Impl& impl_of(const MpiJob& job);
 
 }  // namespace whitted::api

@@ -1,23 +1,12 @@
 // SPDX-License-Identifier: MIT
-// The `whitted` program: render, convert and check scene files. Thin: each command calls the
-// libraries and turns their exceptions into messages and exit codes
-// (0 ok, 1 failure while rendering or checking, 2 bad input or usage, 130/143 interrupted).
+// The `whitted` program: render, convert and check scene files. A user of the public API
+// (whitted/whitted.h) for every command; each turns the API's errors into messages and exit codes
+// (0 ok, 1 failure while rendering or checking, 2 bad input or usage, 130/143 interrupted) through
+// report.h.
 
-#include "api/api_internal.h"
-#include "converters/pov_writer.h"
-#include "converters/yaml_writer.h"
-#include "core/plugin.h"
 #include "explain_command.h"
 #include "live_command.h"
-#include "output/atomic_files.h"
-#include "output/image_output.h"
-#include "render/accelerator.h"
-#include "render/distributed.h"
-#include "render/renderer.h"
-#include "scene/description.h"
-#include "scene/errors.h"
-#include "scene/scene.h"
-#include "scene/text_checks.h"
+#include "report.h"
 #include "whitted/whitted.h"
 
 #include <fmt/format.h>
@@ -58,7 +47,7 @@ std::atomic<int> g_signal{0};
 /// meshes, building the BVH can take seconds), so a signal then ends the program at once.
 std::atomic<bool> g_exit_on_signal{true};
 /// Under mpirun or srun: this process is one rank of a distributed render (docs/distributed.md).
-std::unique_ptr<WorkExchange> g_exchange;
+std::optional<api::MpiJob> g_mpi_job;
 /// CLOCK_MONOTONIC (ns) of the CancelWatchdog's latest 20 ms poll, 0 while no render runs: a
 /// SIGCONT arriving long after it means this process had been stopped (see on_continue).
 std::atomic<int64_t> g_watchdog_tick_ns{0};
@@ -136,10 +125,10 @@ private:
             if (!g_cancel.load()) continue;
             if (done_within(std::chrono::milliseconds(900))) return;
             // Under MPI rank 0 can also be waiting on a rank that died in the middle of a message.
-            std::fprintf(stderr, g_exchange ? "whitted: interrupted; a tile or a message from another rank did not "
-                                              "arrive within a second, stopped without writing anything\n"
-                                            : "whitted: interrupted; a tile did not finish within a second, "
-                                              "stopped without writing anything\n");
+            std::fprintf(stderr, g_mpi_job ? "whitted: interrupted; a tile or a message from another rank did not "
+                                             "arrive within a second, stopped without writing anything\n"
+                                           : "whitted: interrupted; a tile did not finish within a second, "
+                                             "stopped without writing anything\n");
             std::fflush(stderr);
             ::_exit(128 + g_signal.load());
         }
@@ -157,17 +146,13 @@ void install_signal_handlers() {
     sigemptyset(&action.sa_mask);
     sigaction(SIGINT, &action, nullptr);
     sigaction(SIGTERM, &action, nullptr);
-    if (g_exchange) {  // only an MPI rank has an mpirun for a parent (on_continue)
+    if (g_mpi_job) {  // only an MPI rank has an mpirun for a parent (on_continue)
         struct sigaction on_cont {};
         on_cont.sa_sigaction = on_continue;
         on_cont.sa_flags = SA_SIGINFO | SA_RESTART;
         sigemptyset(&on_cont.sa_mask);
         sigaction(SIGCONT, &on_cont, nullptr);
     }
-}
-
-void print_error(const std::string& message) {
-    std::fprintf(stderr, "whitted: error: %s\n", message.c_str());
 }
 
 std::string format_duration(double seconds) {
@@ -217,7 +202,7 @@ struct RenderArguments {
 };
 
 /// --crop's X,Y,WIDTH,HEIGHT (the window's place in the image is checked with the scene).
-api::PixelWindow parse_crop(const std::string& text) {
+api::Expected<api::PixelWindow> parse_crop(const std::string& text) {
     api::PixelWindow window;
     int* const fields[] = {&window.x, &window.y, &window.width, &window.height};
     const char* p = text.data();
@@ -225,13 +210,13 @@ api::PixelWindow parse_crop(const std::string& text) {
     for (size_t i = 0; i < 4; ++i) {
         const auto [next, error] = std::from_chars(p, end, *fields[i]);
         if (error != std::errc() || (i < 3 ? next == end || *next != ',' : next != end))
-            throw std::invalid_argument("--crop: expected X,Y,WIDTH,HEIGHT in pixels (four whole numbers), not '" +
-                                        printable(text) + "'");
+            return api::Error{"--crop: expected X,Y,WIDTH,HEIGHT in pixels (four whole numbers), not '" +
+                              api::printable(text) + "'"};
         p = next + (i < 3 ? 1 : 0);
     }
     if (window.x < 0 || window.y < 0 || window.width < 1 || window.height < 1)
-        throw std::invalid_argument("--crop: X and Y must be at least 0, WIDTH and HEIGHT at least 1 (got '" +
-                                    printable(text) + "')");
+        return api::Error{"--crop: X and Y must be at least 0, WIDTH and HEIGHT at least 1 (got '" +
+                          api::printable(text) + "')"};
     return window;
 }
 
@@ -250,22 +235,13 @@ api::Expected<api::Scene> load_scene_argument(const std::string& scene, const ap
             return api::Error{std::string("cannot read the scene from standard input: ") + std::strerror(errno),
                               "<stdin>"};
         }
-        if (text.size() + size_t(n) > size_t(limits::max_scene_file_bytes))
+        if (text.size() + size_t(n) > size_t(api::limits::max_scene_file_bytes))
             return api::Error{"the scene on standard input is more than " +
-                                  std::to_string(limits::max_scene_file_bytes) + " bytes, the scene file limit",
+                                  std::to_string(api::limits::max_scene_file_bytes) + " bytes, the scene file limit",
                               "<stdin>"};
         text.append(buffer, size_t(n));
     }
     return api::load_scene_string(text, "<stdin>", overrides);
-}
-
-/// Refuses an output that is one of the render's input files (`whitted render s.png -o s.png`
-/// once overwrote the scene): the same file by any name, a link included.
-void refuse_output_over(const std::string& output, const std::string& input, const char* what) {
-    std::error_code error;
-    if (std::filesystem::equivalent(output, input, error))
-        throw std::invalid_argument("refusing to write the image to '" + output + "': it is the " + what + " '" +
-                                    input + "'");
 }
 
 /// Wall-clock time of each stage, printed by --stats.
@@ -283,237 +259,165 @@ private:
     std::chrono::steady_clock::time_point m_start = std::chrono::steady_clock::now(), m_last = m_start;
 };
 
-/// Runs `work`, a check before the render; what it throws is printed as `whitted` prints it, and
-/// the exit status returned (−1: none). `scene` names the file for errors that do not carry a
-/// place (a filesystem error, say).
-template <class Work>
-int exit_on_input_error(const std::string& scene, Work&& work) {
-    try {
-        work();
-        return -1;
-    } catch (...) {
-        return api::report(api::current_error({"checking " + scene, scene, api::Error::Kind::bad_input}));
-    }
-}
-
-/// `whitted render`: a user of the public API (whitted/whitted.h) for loading, rendering and
-/// writing; the usage checks before any work and --stats (which reads the BVH's figures through
-/// the private side of api::Scene) are the program's own.
+/// `whitted render`: load, check the options, build the BVH, render, write, each through the
+/// public API; the usage checks come before any work.
 int run_render(const RenderArguments& args) {
     StageTimer timer;
-    if (const std::string evidence = mpi_launch_evidence(); !evidence.empty()) {
-        try {
-            g_exchange = open_mpi_exchange();
-        } catch (...) {
-            api::Error error = api::current_error({"starting MPI"});
+    if (const std::string evidence = api::mpi_launch_evidence(); !evidence.empty()) {
+        api::Expected<api::MpiJob> joined = api::join_mpi_job();
+        if (!joined) {
+            api::Error error = joined.error();
             error.message += " (this process was started as an MPI rank: " + evidence + ")";
-            return api::report(error);
+            return report(error);
         }
+        g_mpi_job.emplace(std::move(joined).value());
     }
     install_signal_handlers();
-    OutputOptions output = api::output_options(args.write);
-    LayerSet layers;
-    std::optional<api::Scene> loaded;
     // Usage first, in milliseconds: nothing here reads the scene.
     std::optional<api::PixelWindow> crop;
-    const auto check_usage = [&] {
-        if (!args.crop.empty()) crop = parse_crop(args.crop);
-        check_output_path(args.output);
-        if (!args.layers.empty()) {
-            layers = parse_layers(args.layers);
-            if (!layers.empty()) output.layers_from = "--layers";
-        }
-        check_output_options(args.output, output);
-        if (args.scene != "-") refuse_output_over(args.output, args.scene, "scene file");
-        refuse_symlink_target(args.output);
-    };
-    if (const int status = exit_on_input_error(args.scene, check_usage); status >= 0) return status;
-    const InputFilesNoted inputs;  // the scene, its meshes and MTL files, as they are read
+    if (!args.crop.empty()) {
+        const api::Expected<api::PixelWindow> window = parse_crop(args.crop);
+        if (!window) return report(window.error());
+        crop = *window;
+    }
+    if (const auto usable = api::check_image_output(args.output, args.write, args.layers, "--layers",
+                                                    args.scene != "-" ? args.scene : std::string());
+        !usable)
+        return report(usable.error());
     api::Expected<api::Scene> read = load_scene_argument(args.scene, args.overrides);
-    if (!read) return api::report(read.error());
-    loaded.emplace(std::move(read).value());
-    const api::Scene& scene = *loaded;
+    if (!read) return report(read.error());
+    const api::Scene& scene = *read;
     timer.lap();
     api::RenderOptions options;
     options.threads = args.threads;
-    options.layers = args.layers;  // empty: the scene's render.layers, as below
+    options.layers = args.layers;  // empty: the scene's render.layers
     options.crop = crop;
     options.cancel = &g_cancel;
-    // What the scene asks that the output must allow.
-    const auto check_scene_output = [&] {
-        if (args.layers.empty() && !scene.layers().empty()) {
-            // The scene's render.layers, unless --layers was given (--layers none turns them off).
-            layers = parse_layers(loaded->layers());  // validated with the scene: the names are known
-            if (!layers.empty()) {
-                output.layers_from = "render.layers at " + scene.layers_location();
-                check_output_options(args.output, output);
-            }
-        }
-        // Any file the scene read (a mesh, an MTL file an OBJ names), by identity: the same file
-        // under another name or through a link too.
-        if (const std::string input = input_file_at(args.output); !input.empty())
-            throw std::invalid_argument("refusing to write the image to '" + args.output + "': it is " + input);
-        if (crop &&
-            (int64_t(crop->x) + crop->width > scene.width() || int64_t(crop->y) + crop->height > scene.height()))
-            throw std::invalid_argument("--crop " + args.crop + " does not lie inside the " +
-                                        std::to_string(scene.width()) + "x" + std::to_string(scene.height()) +
-                                        " image");
-    };
-    if (const int status = exit_on_input_error(args.scene, check_scene_output); status >= 0) return status;
+    options.mpi_job = g_mpi_job ? &*g_mpi_job : nullptr;
+    // What the scene asks that the output must allow: the scene's render.layers, unless --layers
+    // was given (--layers none turns them off).
+    if (args.layers.empty() && !scene.layers().empty())
+        if (const auto usable = api::check_image_output(args.output, args.write, scene.layers(),
+                                                        "render.layers at " + scene.layers_location());
+            !usable)
+            return report(usable.error());
+    // Any file the scene read (a mesh, an MTL file an OBJ names), by identity: the same file
+    // under another name or through a link too.
+    if (const std::string input = scene.input_file_at(args.output); !input.empty())
+        return report(api::Error{"refusing to write the image to '" + args.output + "': it is " + input});
+    if (crop && (int64_t(crop->x) + crop->width > scene.width() || int64_t(crop->y) + crop->height > scene.height()))
+        return report(api::Error{"--crop " + args.crop + " does not lie inside the " + std::to_string(scene.width()) +
+                                 "x" + std::to_string(scene.height()) + " image"});
     // The rest as api::render checks it (a glazed material cannot have layers), before the BVH.
-    if (const auto usable = api::check_render_options(scene, options); !usable) return api::report(usable.error());
+    if (const auto usable = api::check_render_options(scene, options); !usable) return report(usable.error());
 
-    try {
-        const api::Expected<api::AcceleratorInfo> accelerator = api::prepare(scene, args.threads);  // kept for render
-        if (!accelerator) return api::report(accelerator.error());
-        const double build_seconds = timer.lap();
-        const bool progress_bar = !args.quiet && ::isatty(STDERR_FILENO);
-        if (progress_bar)
-            options.on_progress = [](const api::Progress& p) {
-                draw_progress(p);
-                return true;
-            };
-        g_exit_on_signal.store(false);  // from here on a signal cancels, and we clean up
-        api::Expected<api::RenderResult> rendered = api::Error{};
-        {
-            const CancelWatchdog watchdog;
-            rendered = api::render_distributed(scene, options, g_exchange.get());
-        }
-        if (progress_bar) std::fputc('\n', stderr);
-        if (!rendered) return api::report(rendered.error());
-        const api::RenderResult& result = rendered.value();
-        if (g_exchange && g_exchange->rank() != 0)  // its tiles are with rank 0, which writes the image
-            return result.cancelled ? 128 + (g_signal.load() ? g_signal.load() : SIGINT) : exit_ok;
-        if (g_exchange && !args.quiet)
-            std::fprintf(stderr, "whitted: the tiles were rendered by %d MPI rank(s) (%s)\n", g_exchange->size(),
-                         g_exchange->thread_support().c_str());
-        timer.lap();
-
-        // The scene's file name only: a file sent on should not carry this machine's paths.
-        api::WriteOptions write = args.write;
-        const uint64_t rays = result.stats.camera_rays + result.stats.shadow_rays + result.stats.reflected_rays;
-        write.metadata = {
-            {"whitted:scene", std::filesystem::path(args.scene).filename().string()},
-            {"whitted:settings",
-             fmt::format(
-                 "{}x{}{}, {} sample(s)/pixel, max depth {}, intersection {}", scene.width(), scene.height(),
-                 crop ? fmt::format(" cropped to {}x{} at {},{}", crop->width, crop->height, crop->x, crop->y) : "",
-                 scene.samples() * scene.samples(), scene.max_depth(), scene.intersection())},
-            {"whitted:render_seconds", fmt::format("{:.3f}", result.stats.seconds)},
-            {"whitted:rays", std::to_string(rays)}};
-        if (result.cancelled) {
-            const int signal = g_signal.load();
-            if (args.partial) {
-                write.metadata.push_back({"whitted:partial", "true: interrupted; unfinished tiles are black"});
-                if (const auto written = api::write_image(result.image, args.output, write); !written)
-                    return api::report(written.error());
-                std::fprintf(stderr, "whitted: interrupted; partial image (unfinished tiles black) written to %s\n",
-                             args.output.c_str());
-            } else {
-                std::fprintf(stderr, "whitted: interrupted; nothing written (%s left as it was)\n",
-                             args.output.c_str());
-            }
-            return 128 + (signal ? signal : SIGINT);
-        }
-        if (const auto written = api::write_image(result.image, args.output, write); !written)
-            return api::report(written.error());
-        const double write_seconds = timer.lap();
-        // Radiance past the largest float is +inf in the image, as IEEE arithmetic has it: said,
-        // because only a scene of enormous colours, intensities or mirror weights gets there.
-        const size_t beyond_float = size_t(std::count_if(result.image.rgb.begin(), result.image.rgb.end(),
-                                                         [](float value) { return std::isinf(value); }));
-        if (beyond_float > 0)
-            std::fprintf(stderr,
-                         "whitted: warning: %zu pixel value(s) exceed the largest float (about 3.4e38) and are "
-                         "stored as +inf (clipped to 1 in PNG, JPEG and TIFF): the scene's colours or intensities "
-                         "are that large\n",
-                         beyond_float);
-        const double total = timer.total();
-        const api::SceneCounts counts = scene.counts();
-        if (args.stats)
-            std::fprintf(
-                stderr,
-                "whitted: stages: read (parse, validate, load meshes) %.3fs, build BVH %.3fs, render %.3fs, write "
-                "%.3fs; "
-                "%zu triangles, %zu spheres, %zu boxes, %zu planes, %zu lights, %zu instances (%zu triangles seen); "
-                "BVH %.1f MB (%.1f MB while building); Embree %s, %d-wide packets\n",
-                scene.read_seconds(), build_seconds, result.stats.seconds, write_seconds, counts.triangles,
-                counts.spheres, counts.boxes, counts.planes, counts.lights, counts.instances,
-                counts.instanced_triangles, double(accelerator->bytes) / 1e6, double(accelerator->peak_bytes) / 1e6,
-                accelerator->isa.empty() ? "(its choice)" : accelerator->isa.c_str(), accelerator->lane_width);
-        if (!args.quiet)
-            std::fprintf(
-                stderr,
-                "whitted: %dx%d%s, %d sample(s)/pixel, %u thread(s): render %.3fs (total %.3fs), %.2f M "
-                "rays (camera %.2f, shadow %.2f, reflected %.2f), %.1f M rays/s -> %s\n",
-                scene.width(), scene.height(),
-                crop ? fmt::format(" cropped to {}x{} at {},{}", crop->width, crop->height, crop->x, crop->y).c_str()
-                     : "",
-                scene.samples() * scene.samples(),
-                args.threads > 0 ? unsigned(args.threads) : std::thread::hardware_concurrency(), result.stats.seconds,
-                total, rays / 1e6, result.stats.camera_rays / 1e6, result.stats.shadow_rays / 1e6,
-                result.stats.reflected_rays / 1e6, result.stats.seconds > 0 ? rays / result.stats.seconds / 1e6 : 0.0,
-                args.output.c_str());
-        return exit_ok;
-    } catch (...) {  // e.g. an InputError: a shape beyond the range the accelerator takes
-        return api::report(api::current_error({"rendering " + args.scene}));
+    const api::Expected<api::AcceleratorInfo> accelerator = api::prepare(scene, args.threads);  // kept for render
+    if (!accelerator) return report(accelerator.error());
+    const double build_seconds = timer.lap();
+    const bool progress_bar = !args.quiet && ::isatty(STDERR_FILENO);
+    if (progress_bar)
+        options.on_progress = [](const api::Progress& p) {
+            draw_progress(p);
+            return true;
+        };
+    g_exit_on_signal.store(false);  // from here on a signal cancels, and we clean up
+    api::Expected<api::RenderResult> rendered = api::Error{};
+    {
+        const CancelWatchdog watchdog;
+        rendered = api::render(scene, options);
     }
+    if (progress_bar) std::fputc('\n', stderr);
+    if (!rendered) return report(rendered.error());
+    const api::RenderResult& result = rendered.value();
+    if (g_mpi_job && g_mpi_job->rank() != 0)  // its tiles are with rank 0, which writes the image
+        return result.cancelled ? 128 + (g_signal.load() ? g_signal.load() : SIGINT) : exit_ok;
+    if (g_mpi_job && !args.quiet)
+        std::fprintf(stderr, "whitted: the tiles were rendered by %d MPI rank(s) (%s)\n", g_mpi_job->size(),
+                     g_mpi_job->thread_support().c_str());
+    timer.lap();
+
+    // The scene's file name only: a file sent on should not carry this machine's paths.
+    api::WriteOptions write = args.write;
+    const uint64_t rays = result.stats.camera_rays + result.stats.shadow_rays + result.stats.reflected_rays;
+    write.metadata = {
+        {"whitted:scene", std::filesystem::path(args.scene).filename().string()},
+        {"whitted:settings",
+         fmt::format("{}x{}{}, {} sample(s)/pixel, max depth {}, intersection {}", scene.width(), scene.height(),
+                     crop ? fmt::format(" cropped to {}x{} at {},{}", crop->width, crop->height, crop->x, crop->y) : "",
+                     scene.samples() * scene.samples(), scene.max_depth(), scene.intersection())},
+        {"whitted:render_seconds", fmt::format("{:.3f}", result.stats.seconds)},
+        {"whitted:rays", std::to_string(rays)}};
+    if (result.cancelled) {
+        const int signal = g_signal.load();
+        if (args.partial) {
+            write.metadata.push_back({"whitted:partial", "true: interrupted; unfinished tiles are black"});
+            if (const auto written = api::write_image(result.image, args.output, write); !written)
+                return report(written.error());
+            std::fprintf(stderr, "whitted: interrupted; partial image (unfinished tiles black) written to %s\n",
+                         args.output.c_str());
+        } else {
+            std::fprintf(stderr, "whitted: interrupted; nothing written (%s left as it was)\n", args.output.c_str());
+        }
+        return 128 + (signal ? signal : SIGINT);
+    }
+    if (const auto written = api::write_image(result.image, args.output, write); !written)
+        return report(written.error());
+    const double write_seconds = timer.lap();
+    // Radiance past the largest float is +inf in the image, as IEEE arithmetic has it: said,
+    // because only a scene of enormous colours, intensities or mirror weights gets there.
+    const size_t beyond_float = size_t(
+        std::count_if(result.image.rgb.begin(), result.image.rgb.end(), [](float value) { return std::isinf(value); }));
+    if (beyond_float > 0)
+        std::fprintf(stderr,
+                     "whitted: warning: %zu pixel value(s) exceed the largest float (about 3.4e38) and are "
+                     "stored as +inf (clipped to 1 in PNG, JPEG and TIFF): the scene's colours or intensities "
+                     "are that large\n",
+                     beyond_float);
+    const double total = timer.total();
+    const api::SceneCounts counts = scene.counts();
+    if (args.stats)
+        std::fprintf(
+            stderr,
+            "whitted: stages: read (parse, validate, load meshes) %.3fs, build BVH %.3fs, render %.3fs, write "
+            "%.3fs; "
+            "%zu triangles, %zu spheres, %zu boxes, %zu planes, %zu lights, %zu instances (%zu triangles seen); "
+            "BVH %.1f MB (%.1f MB while building); Embree %s, %d-wide packets\n",
+            scene.read_seconds(), build_seconds, result.stats.seconds, write_seconds, counts.triangles, counts.spheres,
+            counts.boxes, counts.planes, counts.lights, counts.instances, counts.instanced_triangles,
+            double(accelerator->bytes) / 1e6, double(accelerator->peak_bytes) / 1e6,
+            accelerator->isa.empty() ? "(its choice)" : accelerator->isa.c_str(), accelerator->lane_width);
+    if (!args.quiet)
+        std::fprintf(
+            stderr,
+            "whitted: %dx%d%s, %d sample(s)/pixel, %u thread(s): render %.3fs (total %.3fs), %.2f M "
+            "rays (camera %.2f, shadow %.2f, reflected %.2f), %.1f M rays/s -> %s\n",
+            scene.width(), scene.height(),
+            crop ? fmt::format(" cropped to {}x{} at {},{}", crop->width, crop->height, crop->x, crop->y).c_str() : "",
+            scene.samples() * scene.samples(),
+            args.threads > 0 ? unsigned(args.threads) : std::thread::hardware_concurrency(), result.stats.seconds,
+            total, rays / 1e6, result.stats.camera_rays / 1e6, result.stats.shadow_rays / 1e6,
+            result.stats.reflected_rays / 1e6, result.stats.seconds > 0 ? rays / result.stats.seconds / 1e6 : 0.0,
+            args.output.c_str());
+    return exit_ok;
 }
 
-/// A usage error when writing `target` would replace `input`, a file the same command reads.
-void refuse_overwriting_input(const std::filesystem::path& target, const std::string& input) {
-    std::error_code error;
-    if (std::filesystem::exists(target, error) && std::filesystem::equivalent(target, input, error) && !error)
-        throw std::invalid_argument("cannot write '" + target.string() + "': it is the input '" + input +
-                                    "' of the same command");
-}
-
+/// `whitted convert`: the scene as loaded (its description, not the file read again) in the
+/// format the output's extension names.
 int run_convert(const std::string& scene_path, const std::string& output) {
     // SIGINT/SIGTERM end the program at once (130/143): the files are written unnamed and only
-    // named when complete (write_files_atomically), so there is nothing to clean up.
+    // named when complete, so there is nothing to clean up.
     install_signal_handlers();
-    try {
-        const std::string ext = std::filesystem::path(output).extension().string();
-        const bool to_yaml = ext == ".yaml" || ext == ".yml";
-        if (!to_yaml && ext != ".pov")
-            throw std::invalid_argument("cannot convert to '" + output + "': unknown format '" + ext +
-                                        "'; supported: .pov (POV-Ray 3.7), .yaml/.yml (Whitted's own format)");
-        // Usage errors before any work: where the file(s) cannot go.
-        std::filesystem::path ini_path(output);
-        ini_path.replace_extension(".ini");
-        refuse_overwriting_input(output, scene_path);
-        check_can_write(output);
-        if (!to_yaml) {
-            pov::check_pov_file_name(output);
-            refuse_overwriting_input(ini_path, scene_path);
-            check_can_write(ini_path);
-        }
-        refuse_symlink_target(output);
-        if (!to_yaml) refuse_symlink_target(ini_path);
-        const InputFilesNoted inputs;  // the scene, its meshes and MTL files, as they are read
-        const SceneDescription description = parse_scene_file(scene_path);
-        // Refuses what Whitted itself would refuse; reads the meshes once, for the writer too.
-        const Scene built = validate_scene(description);
-        // An output that is a mesh or MTL file of the scene under another name (`mtllib
-        // out.ini`, a mesh named `mesh.pov`): refused before a byte is written.
-        for (const std::filesystem::path& target : {std::filesystem::path(output), ini_path}) {
-            if (to_yaml && target == ini_path) continue;
-            if (const std::string input = input_file_at(target.string()); !input.empty())
-                throw std::invalid_argument("cannot write '" + target.string() + "': it is " + input +
-                                            ", an input of the same command");
-        }
-        if (to_yaml) {
-            // Any scene Whitted reads (a course .xml file, say) in Whitted's own format.
-            yaml::write_yaml_file(description, output);
-            std::fprintf(stderr, "whitted: wrote %s\n", output.c_str());
-            return exit_ok;
-        }
-        const std::string ini = pov::write_pov_files(description, built, output);
-        std::fprintf(stderr, "whitted: wrote %s and %s\n", output.c_str(), ini.c_str());
-        return exit_ok;
-    } catch (...) {
-        return api::report(api::current_error({"converting " + scene_path}));
-    }
+    // Usage errors before any work: where the file(s) cannot go.
+    if (const auto usable = api::check_convert_output(output, scene_path); !usable) return report(usable.error());
+    const api::Expected<api::Scene> scene = api::load_scene_file(scene_path);
+    if (!scene) return report(scene.error());
+    const api::Expected<std::vector<std::string>> written = api::convert(*scene, output);
+    if (!written) return report(written.error());
+    if (written->size() == 1)
+        std::fprintf(stderr, "whitted: wrote %s\n", written->front().c_str());
+    else
+        std::fprintf(stderr, "whitted: wrote %s and %s\n", written->front().c_str(), written->back().c_str());
+    return exit_ok;
 }
 
 int run_check_command(const std::string& scene_path, api::CheckOptions options) {
@@ -525,7 +429,7 @@ int run_check_command(const std::string& scene_path, api::CheckOptions options) 
     install_signal_handlers();
     const api::Expected<api::CheckResult> checked = api::check(scene_path, options);
     if (!checked) {
-        if (checked.error().kind != api::Error::Kind::cancelled) return api::report(checked.error());
+        if (checked.error().kind != api::Error::Kind::cancelled) return report(checked.error());
         std::fprintf(stderr, "whitted: %s\n", checked.error().message.c_str());
         return 128 + (g_signal.load() ? g_signal.load() : SIGINT);
     }
@@ -534,7 +438,7 @@ int run_check_command(const std::string& scene_path, api::CheckOptions options) 
 
 int run_compare_command(const std::string& first, const std::string& second, const api::PassRule& rule, bool clip) {
     const api::Expected<api::Comparison> compared = api::compare_image_files(first, second, rule, clip);
-    if (!compared) return api::report(compared.error());
+    if (!compared) return report(compared.error());
     if (!compared->first_meaning.empty())
         std::printf("%s: %s\n%s: %s\n", first.c_str(), compared->first_meaning.c_str(), second.c_str(),
                     compared->second_meaning.c_str());
@@ -543,14 +447,14 @@ int run_compare_command(const std::string& first, const std::string& second, con
 }
 
 int run_colour(bool list, const std::string& config, const std::string& write_config) {
-    if (!config.empty() && !list) return api::report(api::Error{"--ocio-config goes with --list"});
+    if (!config.empty() && !list) return report(api::Error{"--ocio-config goes with --list"});
     if (!write_config.empty()) {
-        if (const auto written = api::write_colour_config(write_config); !written) return api::report(written.error());
+        if (const auto written = api::write_colour_config(write_config); !written) return report(written.error());
         std::fprintf(stderr, "whitted: wrote the built-in OpenColorIO config to %s\n", write_config.c_str());
     }
     if (list) {
         const api::Expected<std::string> text = api::describe_colour_config(config);
-        if (!text) return api::report(text.error());
+        if (!text) return report(text.error());
         std::fputs(text->c_str(), stdout);
     }
     return exit_ok;
@@ -560,17 +464,13 @@ int run_colour(bool list, const std::string& config, const std::string& write_co
 /// paths run, the instruction sets Embree can use here and the one in use.
 std::string version_text() {
     std::string text = std::string("whitted ") + api::version();
-    try {
-        const std::string isa = embree_isa_from_environment();
-        const EmbreeInfo info = embree_info(isa);
-        std::string isas;
-        for (const std::string& name : info.isas) isas += (isas.empty() ? "" : " ") + name;
-        text += "\nEmbree " + info.version + "; instruction sets this CPU can run: " + isas;
-        text += "\nin use: " + info.isa_in_use + (isa.empty() ? " (the widest)" : " (WHITTED_EMBREE_ISA)") + ", " +
-                std::to_string(info.lane_width) + "-wide packets";
-    } catch (const std::exception& e) {
-        text += "\nEmbree: " + std::string(e.what());
-    }
+    const api::Expected<api::EmbreeInfo> info = api::embree_info();
+    if (!info) return text + "\nEmbree: " + info.error().what();
+    std::string isas;
+    for (const std::string& name : info->isas) isas += (isas.empty() ? "" : " ") + name;
+    text += "\nEmbree " + info->version + "; instruction sets this CPU can run: " + isas;
+    text += "\nin use: " + info->isa_in_use + (info->isa_from_environment ? " (WHITTED_EMBREE_ISA)" : " (the widest)") +
+            ", " + std::to_string(info->lane_width) + "-wide packets";
     return text;
 }
 
@@ -589,18 +489,6 @@ std::string documentation_root() {
         return WHITTED_SOURCE_DIR;
 #endif
     return {};
-}
-
-/// WHITTED_EMBREE_ISA, checked before any work: a name Embree does not know, or an instruction
-/// set this CPU lacks, is a usage error (exit 2), not a failure after parsing and loading.
-bool embree_isa_usable() {
-    try {
-        require_embree_isa(embree_isa_from_environment());
-        return true;
-    } catch (...) {
-        api::report(api::current_error({"checking WHITTED_EMBREE_ISA", "", api::Error::Kind::bad_input}));
-        return false;
-    }
 }
 
 }  // namespace
@@ -675,19 +563,19 @@ int main(int argc, char** argv) {
     render_cmd
         ->add_option("--width", render_args.overrides.width,
                      "Image width in pixels, replacing image.width (alone: the height keeps the aspect ratio)")
-        ->check(CLI::Range(1, int(limits::max_image_side)));
+        ->check(CLI::Range(1, int(api::limits::max_image_side)));
     render_cmd
         ->add_option("--height", render_args.overrides.height,
                      "Image height in pixels, replacing image.height (alone: the width keeps the aspect ratio)")
-        ->check(CLI::Range(1, int(limits::max_image_side)));
+        ->check(CLI::Range(1, int(api::limits::max_image_side)));
     render_cmd
         ->add_option("--samples", render_args.overrides.samples,
                      "Samples per pixel side, replacing image.samples (n: n*n rays per pixel)")
-        ->check(CLI::Range(1, int(limits::max_samples)));
+        ->check(CLI::Range(1, int(api::limits::max_samples)));
     render_cmd
         ->add_option("--max-depth", render_args.overrides.max_depth,
                      "Mirror and refraction bounces, replacing render.max_depth")
-        ->check(CLI::Range(1, int(limits::max_depth)));
+        ->check(CLI::Range(1, int(api::limits::max_depth)));
     render_cmd
         ->add_option("--intersection", render_args.overrides.intersection,
                      "How hits are decided, replacing render.intersection: exact (the default) or povray "
@@ -700,7 +588,8 @@ int main(int argc, char** argv) {
     render_cmd
         ->add_option(
             "--layers", render_args.layers,
-            "EXR only: write render layers as extra channels, 'all' or a comma-separated list of: " + layer_choices() +
+            "EXR only: write render layers as extra channels, 'all' or a comma-separated list of: " +
+                api::layer_choices() +
                 " (docs/layers.md); overrides the scene's render.layers, 'none' turns them off. The "
                 "beauty R, G, B is then the float sum of ambient, diffuse, specular, mirror, transmission, background")
         ->delimiter(',');
@@ -838,9 +727,9 @@ int main(int argc, char** argv) {
         if (!known) {
             std::string list;
             for (const std::string& name : commands) list += (list.empty() ? "" : ", ") + name;
-            print_error("unknown command '" + printable(argv[1]) + "'" + did_you_mean(argv[1], commands) +
-                        "; the commands are " + list + " (whitted --help)");
-            return exit_bad_input;
+            return report(api::Error{"unknown command '" + api::printable(argv[1]) + "'" +
+                                     api::did_you_mean(argv[1], commands) + "; the commands are " + list +
+                                     " (whitted --help)"});
         }
     }
     try {
@@ -850,26 +739,39 @@ int main(int argc, char** argv) {
         return code == 0 ? 0 : exit_bad_input;
     }
 
-    if ((*render_cmd || *check_cmd || *explain_cmd || *live_cmd) && !embree_isa_usable()) return exit_bad_input;
+    // WHITTED_EMBREE_ISA, checked before any work: a name Embree does not know, or an instruction
+    // set this CPU lacks, is a usage error, not a failure after parsing and loading.
+    if (*render_cmd || *check_cmd || *explain_cmd || *live_cmd)
+        if (const auto usable = api::check_embree_isa(); !usable) return report(usable.error());
     if (*live_cmd) {
         live_args.open_browser = !live_no_open;
         return run_live(live_args);
     }
+    // What a command's own code throws (out of memory, say) is reported as the library reports
+    // its errors, by run_reporting.
     if (*explain_cmd)
-        return run_explain(explain_scene, explain_pixel_text, explain_json, explain_summary, explain_threads);
+        return run_reporting("explaining a pixel of " + explain_scene, [&] {
+            return run_explain(explain_scene, explain_pixel_text, explain_json, explain_summary, explain_threads);
+        });
     if (*render_cmd) {
-        const int code = run_render(render_args);
+        const int code = run_reporting("rendering " + render_args.scene, [&] { return run_render(render_args); });
         // Every rank finalizes only after success: a rank that failed exits without, so that
         // mpirun ends the whole job instead of the others waiting for it (docs/distributed.md).
-        if (code == exit_ok && g_exchange) g_exchange->finalize();
+        if (code == exit_ok && g_mpi_job) g_mpi_job->finalize();
         // The image is on disk and the summary printed: skip tearing down the BVH, the image
         // buffers and the thread pools, which took up to 30 ms of a 0.15 s render. Nothing is
         // left to flush but stdio.
         std::fflush(nullptr);
         std::_Exit(code);
     }
-    if (*convert_cmd) return run_convert(convert_scene, convert_output);
-    if (*colour_cmd) return run_colour(colour_list, colour_config, colour_write);
-    if (*compare_cmd) return run_compare_command(compare_first, compare_second, compare_rule, compare_clip);
-    return run_check_command(check_scene, check_options);
+    if (*convert_cmd)
+        return run_reporting("converting " + convert_scene, [&] { return run_convert(convert_scene, convert_output); });
+    if (*colour_cmd)
+        return run_reporting("listing the colour config",
+                             [&] { return run_colour(colour_list, colour_config, colour_write); });
+    if (*compare_cmd)
+        return run_reporting("comparing " + compare_first + " and " + compare_second, [&] {
+            return run_compare_command(compare_first, compare_second, compare_rule, compare_clip);
+        });
+    return run_reporting("checking " + check_scene, [&] { return run_check_command(check_scene, check_options); });
 }

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// The doors of the public API that `whitted compare`, `colour`, `check` and `explain` go through
-// (docs/library.md), used as a caller does: only whitted/whitted.h, linked with libwhitted.so.
+// The doors of the public API that `whitted render`, `convert`, `compare`, `colour`, `check` and
+// `explain` go through (docs/library.md), used as a caller does: only whitted/whitted.h, linked with libwhitted.so.
 // Each function's result and each of its error paths.
 // Usage: api_doors_test SOURCE_DIR WORK_DIR
 
@@ -13,6 +13,7 @@
 #include <iterator>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace fs = std::filesystem;
 using namespace whitted;
@@ -207,6 +208,97 @@ void explain(const fs::path& source) {
     }
 }
 
+std::string read_file(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void write_file(const fs::path& path, const std::string& text) {
+    std::ofstream(path, std::ios::binary) << text;
+}
+
+/// `whitted convert`: the scene as it was loaded, not as its file says later; the usage checks
+/// before any work; an output that is one of the scene's own files refused.
+void convert(const fs::path& work) {
+    const std::string scene_text =
+        "version: 1\nimage: {width: 8, height: 6}\ncamera: {eye: [0, 0, 5], look_at: [0, 0, 0], fov: 40}\n"
+        "lights:\n  - {type: point, position: [2, 3, 4], intensity: [1, 1, 1]}\n"
+        "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1.25, material: {kd: [0.5, 0.25, 0.125]}}\n";
+    const fs::path path = work / "loaded.yaml";
+    write_file(path, scene_text);
+    const api::Expected<api::Scene> scene = api::load_scene_file(path.string());
+    EXPECT(scene.has_value());
+    if (!scene) return;
+    // The file changes after loading: the conversion is still of the scene loaded (radius 1.25).
+    std::string changed = scene_text;
+    changed.replace(changed.find("radius: 1.25"), 12, "radius: 2.75");
+    write_file(path, changed);
+    const api::Expected<std::vector<std::string>> yaml = api::convert(*scene, (work / "out.yaml").string());
+    EXPECT(yaml && yaml->size() == 1 && yaml->front() == (work / "out.yaml").string());
+    const std::string yaml_text = read_file(work / "out.yaml");
+    EXPECT(contains(yaml_text, "1.25") && !contains(yaml_text, "2.75"));
+    const api::Expected<std::vector<std::string>> pov = api::convert(*scene, (work / "out.pov").string());
+    EXPECT(pov && pov->size() == 2 && pov->back() == (work / "out.ini").string());
+    const std::string sdl = read_file(work / "out.pov");
+    EXPECT(contains(sdl, "1.25") && !contains(sdl, "2.75"));
+    EXPECT(fs::exists(work / "out.ini"));
+    const api::Expected<std::string> to_povray = api::to_povray(*scene);
+    EXPECT(to_povray && *to_povray == sdl);
+
+    // Refused: the scene file itself (under another name too), an unknown format, a .pov whose
+    // .ini is the scene; all bad input, nothing written.
+    const fs::path link = work / "link.yaml";
+    fs::create_symlink(path, link);
+    for (const fs::path& output : {path, link}) {
+        const api::Expected<std::vector<std::string>> over = api::convert(*scene, output.string());
+        EXPECT(!over && over.error().kind == api::Error::Kind::bad_input && contains(over.error().what(), "an input"));
+    }
+    EXPECT(read_file(path) == changed);
+    const api::Expected<void> unknown = api::check_convert_output((work / "out.obj").string(), path.string());
+    EXPECT(!unknown && unknown.error().kind == api::Error::Kind::bad_input &&
+           contains(unknown.error().what(), "unknown format '.obj'"));
+    const api::Expected<void> ini_over = api::check_convert_output((work / "loaded.pov").string(), path.string());
+    EXPECT(ini_over.has_value());  // loaded.ini is not the scene
+    const api::Expected<void> over_input = api::check_convert_output(path.string(), path.string());
+    EXPECT(!over_input && contains(over_input.error().what(), "it is the input"));
+    EXPECT(api::check_convert_output((work / "fine.yaml").string(), path.string()).has_value());
+    EXPECT(!api::check_convert_output(link.string()).has_value());  // a symbolic link is not written through
+
+    // A scene loaded for rendering only keeps no description to convert.
+    const api::Expected<api::Scene> render_only = api::load_scene_file(path.string(), {}, api::SceneUse::render_only);
+    const api::Expected<std::vector<std::string>> none = api::convert(*render_only, (work / "none.yaml").string());
+    EXPECT(!none && !fs::exists(work / "none.yaml"));
+}
+
+/// `whitted render`'s checks before any work, and the scene's own files.
+void render_checks(const fs::path& source, const fs::path& work) {
+    const std::string scene_path = (source / "tests/pov/three_coloured_lights.yaml").string();
+    EXPECT(api::check_image_output((work / "a.png").string(), {}).has_value());
+    EXPECT(api::check_image_output((work / "a.exr").string(), {}, {"diffuse", "N"}, "--layers").has_value());
+    const api::Expected<void> png_layers =
+        api::check_image_output((work / "a.png").string(), {}, {"diffuse"}, "--layers");
+    EXPECT(!png_layers && png_layers.error().kind == api::Error::Kind::bad_input &&
+           contains(png_layers.error().what(), "render layers (--layers)"));
+    EXPECT(api::check_image_output((work / "a.png").string(), {}, {"none"}, "--layers").has_value());
+    const api::Expected<void> unknown_layer = api::check_image_output((work / "a.exr").string(), {}, {"difuse"});
+    EXPECT(!unknown_layer && contains(unknown_layer.error().what(), "did you mean 'diffuse'"));
+    api::WriteOptions half;
+    half.half = true;
+    EXPECT(!api::check_image_output((work / "a.png").string(), half).has_value());
+    EXPECT(!api::check_image_output((work / "a.yaml").string(), {}).has_value());
+    const fs::path copy = work / "scene.png";
+    fs::copy_file(scene_path, copy);
+    const api::Expected<void> over = api::check_image_output(copy.string(), {}, {}, {}, copy.string());
+    EXPECT(!over && contains(over.error().what(), "it is the scene file"));
+
+    const api::Expected<api::Scene> scene = api::load_scene_file(scene_path, {}, api::SceneUse::render_only);
+    EXPECT(scene && contains(scene->input_file_at(scene_path), "three_coloured_lights.yaml"));
+    EXPECT(scene && scene->input_file_at((work / "a.png").string()).empty());
+    EXPECT(!api::layer_choices().empty() && contains(api::layer_choices(), "diffuse"));
+    EXPECT(starts_with(api::printable("a\x1b"), "a\\x") && api::printable("a\x1b").find('\x1b') == std::string::npos);
+    EXPECT(api::exit_status(api::Error{}) == api::exit_bad_input);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -221,7 +313,11 @@ int main(int argc, char** argv) {
     colour_config(work);
     check(source, work);
     explain(source);
+    convert(work);
+    render_checks(source, work);
     if (failures) return 1;
-    std::printf("PASS: compare_image_files, describe_colour_config, write_colour_config, check, explain\n");
+    std::printf(
+        "PASS: compare_image_files, describe_colour_config, write_colour_config, check, explain, convert, render "
+        "checks\n");
     return 0;
 }

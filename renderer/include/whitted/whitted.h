@@ -57,6 +57,19 @@ struct Error {
     }
 };
 
+/// `whitted`'s exit statuses (its --help footer); 128 + the signal when interrupted.
+enum ExitStatus : int { exit_ok = 0, exit_failure = 1, exit_bad_input = 2 };
+
+/// The exit status `whitted` gives for the error: 2 for bad input, 1 otherwise.
+inline int exit_status(const Error& error) {
+    return error.kind == Error::Kind::bad_input ? exit_bad_input : exit_failure;
+}
+
+/// The exception being handled, as an Error by the rules every function here follows
+/// (std::invalid_argument is bad input, running out of memory a failure "while `doing`", ...),
+/// for a program's own code over the API; call only inside a catch block.
+WHITTED_API Error error_of_current_exception(const std::string& doing);
+
 /// Thrown only by Expected::value() on an error (a programming mistake: test first).
 class BadExpectedAccess : public std::runtime_error {
 public:
@@ -147,6 +160,10 @@ public:
     SceneCounts counts() const;
     /// Wall time load_scene_* took: reading, validating and loading the meshes, seconds.
     double read_seconds() const;
+    /// What `path` is among the files read to load the scene (the scene file, its meshes and
+    /// MTL files, by identity: under any name or through a link), e.g. "the mesh file 'm.obj'";
+    /// empty when it is none of them or does not exist. For refusing an output over an input.
+    std::string input_file_at(const std::string& path) const;
 
 private:
     friend const Impl& impl_of(const Scene& scene);  ///< the library's own access
@@ -234,6 +251,38 @@ struct PixelWindow {
     int x = 0, y = 0, width = 0, height = 0;
 };
 
+/// Why this process looks like one rank of an MPI job (e.g. "OMPI_COMM_WORLD_SIZE=4"), or ""
+/// when it does not; $WHITTED_MPI=0 says never, 1 always (docs/distributed.md).
+WHITTED_API std::string mpi_launch_evidence();
+
+/// This process as one rank of an MPI job (docs/distributed.md): with RenderOptions::mpi_job,
+/// render() shares the tiles out among the ranks. MPI itself lives in a plug-in
+/// (lib/libwhitted_mpi.so), loaded by join_mpi_job() only. Move-only.
+class WHITTED_API MpiJob {
+public:
+    struct Impl;  ///< private (renderer/api/api_internal.h)
+    explicit MpiJob(std::unique_ptr<Impl> impl);
+    MpiJob(MpiJob&&) noexcept;
+    MpiJob& operator=(MpiJob&&) noexcept;
+    ~MpiJob();
+
+    int rank() const;  ///< 0: the rank that receives every tile and writes the image
+    int size() const;  ///< the number of ranks
+    /// The thread support MPI_Init_thread gave, e.g. "MPI_THREAD_MULTIPLE".
+    std::string thread_support() const;
+    /// MPI_Finalize: once, after the last render, on the thread that joined. A rank that failed
+    /// should exit without it, so that mpirun ends the whole job.
+    void finalize();
+
+private:
+    friend const Impl& impl_of(const MpiJob& job);  ///< the library's own access
+    std::unique_ptr<Impl> m_impl;
+};
+
+/// Loads the MPI plug-in and initialises MPI; an Error (failure) says where the plug-in was
+/// looked for when it cannot.
+WHITTED_API Expected<MpiJob> join_mpi_job();
+
 struct RenderOptions {
     int threads = 0;  ///< 0 = all cores; the image is bit-identical for any number
     /// Render only this window of the image (`whitted render --crop`): the result is an image of
@@ -248,6 +297,10 @@ struct RenderOptions {
     std::function<bool(const Progress&)> on_progress;
     /// Set to true (from any thread, or a signal handler) to stop: checked before every tile.
     const std::atomic<bool>* cancel = nullptr;
+    /// Share the tiles out among this MPI job's ranks (null: this process alone): on rank 0 the
+    /// result is the whole image, with every rank's rays; on the others, only the tiles that rank
+    /// rendered. Render layers are refused: they are not sent between ranks.
+    MpiJob* mpi_job = nullptr;
 };
 
 struct RenderStats {
@@ -302,6 +355,45 @@ struct WriteOptions {
 /// file appears complete or not at all.
 WHITTED_API Expected<void> write_image(const Image& image, const std::string& path, const WriteOptions& options = {});
 
+/// Checks, before any work, that write_image can write `path` with `options`, as `whitted
+/// render` does first: an image extension it writes, every option applying to that format, the
+/// `layers` (names as RenderOptions::layers) known and the format able to hold them (named as
+/// asked for by `layers_from`, e.g. "--layers"), no symbolic link at `path` (writing replaces
+/// it, it would not write through it), and not the file `input` (a scene file, by any name).
+WHITTED_API Expected<void> check_image_output(const std::string& path, const WriteOptions& options,
+                                              const std::vector<std::string>& layers = {},
+                                              const std::string& layers_from = {}, const std::string& input = {});
+
+/// The render layers' names RenderOptions::layers takes (besides "all" and "none"), comma-separated.
+WHITTED_API std::string layer_choices();
+
+/// The largest values a scene may hold (docs/scene-format.md), as its readers check them.
+namespace limits {
+inline constexpr int max_image_side = 65536;
+inline constexpr int max_samples = 16;  ///< 256 rays per pixel
+inline constexpr int max_depth = 256;
+inline constexpr int64_t max_scene_file_bytes = int64_t(256) << 20;
+}  // namespace limits
+
+/// What Embree, which finds the hits, can do on this CPU (`whitted --version`).
+struct EmbreeInfo {
+    std::string version;                ///< e.g. "3.13.5"
+    std::vector<std::string> isas;      ///< the instruction sets this CPU can run, narrowest first
+    std::string isa_in_use;             ///< $WHITTED_EMBREE_ISA, else the widest of `isas`
+    bool isa_from_environment = false;  ///< $WHITTED_EMBREE_ISA chose it
+    int lane_width = 1;                 ///< rays per packet given to Embree with it
+};
+WHITTED_API Expected<EmbreeInfo> embree_info();
+/// $WHITTED_EMBREE_ISA, checked before any work: a name Embree does not know, or an instruction
+/// set this CPU lacks, is an Error (bad_input). The image is the same for every one.
+WHITTED_API Expected<void> check_embree_isa();
+
+/// `text` (a file name or word the user typed) made safe to print in a message: control
+/// characters and bytes that are not UTF-8 as \xNN, at most `max_characters` characters.
+WHITTED_API std::string printable(const std::string& text, size_t max_characters = 60);
+/// " (did you mean 'x'?)" for the closest of `candidates` within a small edit distance, else "".
+WHITTED_API std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates);
+
 /// How explain() writes the pixel's equation.
 enum class ExplainFormat {
     text,     ///< every sample, segment, light and term with its numbers (`whitted explain`)
@@ -325,6 +417,17 @@ WHITTED_API Expected<std::string> explain(const Scene& scene, int x, int y, cons
 WHITTED_API Expected<std::string> to_povray(const Scene& scene);
 /// Writes `pov_path` and the .ini beside it that renders it like Whitted; returns the .ini path.
 WHITTED_API Expected<std::string> write_povray(const Scene& scene, const std::string& pov_path);
+
+/// Checks, before any work, that convert() can write `output`, as `whitted convert` does first:
+/// a format its extension names (.pov with the .ini beside it, .yaml/.yml), files that can be
+/// written there, no symbolic link, and not the file `input` (the scene file, by any name).
+WHITTED_API Expected<void> check_convert_output(const std::string& output, const std::string& input = {});
+/// `whitted convert`: writes the scene in the format `output`'s extension names: .pov (POV-Ray
+/// 3.7 SDL and the .ini beside it, as write_povray) or .yaml/.yml (Whitted's own format, as the
+/// description said it). The description it was loaded from (SceneUse::any) is written, whatever
+/// its file says now; an output that is one of the files it was read from is refused (bad_input)
+/// before a byte is written. Returns the files written.
+WHITTED_API Expected<std::vector<std::string>> convert(const Scene& scene, const std::string& output);
 
 /// How `whitted check` runs (its options of the same names).
 struct CheckOptions {

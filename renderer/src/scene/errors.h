@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
-// The one mapping from what the private libraries throw to an api::Error, and from an Error to
-// `whitted`'s exit status. The library (api.cpp), the OpenImageIO plug-in (reference/plugin.cpp)
-// and every command of the program use it, so a kind of mistake means the same status everywhere.
+// The one mapping from what the private libraries throw to an api::Error (whose exit status
+// api::exit_status gives). The library (api.cpp; api::error_of_current_exception for the program's
+// own code) and the OpenImageIO plug-in (reference/plugin.cpp) use it, so a kind of mistake means
+// the same status everywhere.
 // Inline: the plug-in is a module of its own and does not link the API library. It lives with the
 // scene, where InputError and FileChangedWhileRead are defined, below both the API and the
 // reference tools that use it.
@@ -20,9 +21,6 @@
 #include <utility>
 
 namespace whitted::api {
-
-/// `whitted`'s exit statuses (its --help footer); 128 + the signal when interrupted.
-enum ExitStatus : int { exit_ok = 0, exit_failure = 1, exit_bad_input = 2 };
 
 /// What the work was, for the exceptions that do not say so themselves.
 struct ErrorContext {
@@ -72,28 +70,6 @@ inline Error current_error(const ErrorContext& context) {
     }
     error.file = context.file;
     return error;
-}
-
-/// The exit status `whitted` gives for the error: 2 for bad input, 1 otherwise.
-inline int exit_status(const Error& error) {
-    return error.kind == Error::Kind::bad_input ? exit_bad_input : exit_failure;
-}
-
-/// Prints the error as `whitted` prints every error ("whitted: error: FILE:LINE:COL: message")
-/// and returns its exit status.
-inline int report(const Error& error) {
-    std::fprintf(stderr, "whitted: error: %s\n", error.what().c_str());
-    return exit_status(error);
-}
-
-/// Runs `work` (returning an exit status); what it throws is reported, and its status returned.
-template <class Work>
-int run_reporting(const ErrorContext& context, Work&& work) {
-    try {
-        return work();
-    } catch (...) {
-        return report(current_error(context));
-    }
 }
 
 }  // namespace whitted::api

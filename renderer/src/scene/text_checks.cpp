@@ -87,18 +87,14 @@ void release_mapping(int slot) {
 }
 
 /// The files read while an InputFilesNoted lives.
-struct NotedInput {
-    dev_t device;
-    ino_t inode;
-    std::string what;  ///< "the mesh file 'm.obj'"
-};
 std::mutex g_noted_mutex;
 int g_noting = 0;
 std::vector<NotedInput> g_noted;
 
 void note_input(const struct stat& info, const std::string& path, const std::string& what) {
     const std::lock_guard<std::mutex> lock(g_noted_mutex);
-    if (g_noting > 0) g_noted.push_back({info.st_dev, info.st_ino, "the " + what + " '" + path + "'"});
+    if (g_noting > 0)
+        g_noted.push_back({uint64_t(info.st_dev), uint64_t(info.st_ino), "the " + what + " '" + path + "'"});
 }
 
 }  // namespace
@@ -106,6 +102,7 @@ void note_input(const struct stat& info, const std::string& path, const std::str
 InputFilesNoted::InputFilesNoted() {
     const std::lock_guard<std::mutex> lock(g_noted_mutex);
     ++g_noting;
+    m_first = g_noted.size();  // the list is cleared only when no InputFilesNoted lives
 }
 
 InputFilesNoted::~InputFilesNoted() {
@@ -113,13 +110,22 @@ InputFilesNoted::~InputFilesNoted() {
     if (--g_noting == 0) g_noted.clear();
 }
 
-std::string input_file_at(const std::string& target) {
+std::vector<NotedInput> InputFilesNoted::noted() const {
+    const std::lock_guard<std::mutex> lock(g_noted_mutex);
+    return {g_noted.begin() + std::ptrdiff_t(m_first), g_noted.end()};
+}
+
+std::string input_file_at(const std::string& target, const std::vector<NotedInput>& inputs) {
     struct stat info {};
     if (::stat(target.c_str(), &info) != 0) return {};
-    const std::lock_guard<std::mutex> lock(g_noted_mutex);
-    for (const NotedInput& input : g_noted)
-        if (input.device == info.st_dev && input.inode == info.st_ino) return input.what;
+    for (const NotedInput& input : inputs)
+        if (input.device == uint64_t(info.st_dev) && input.inode == uint64_t(info.st_ino)) return input.what;
     return {};
+}
+
+std::string input_file_at(const std::string& target) {
+    const std::lock_guard<std::mutex> lock(g_noted_mutex);
+    return input_file_at(target, g_noted);
 }
 
 std::string read_text_file(const std::string& path, int64_t max_bytes, const std::string& what) {

@@ -100,22 +100,36 @@ private:
     size_t m_let_go = 0;  ///< bytes from the start let go by the latest reader (whole pages)
 };
 
+/// A file read while an InputFilesNoted lived, by its identity (device and inode).
+struct NotedInput {
+    uint64_t device = 0, inode = 0;
+    std::string what;  ///< "the mesh file 'm.obj'"
+};
+
 /// While one lives, every file opened by MappedTextFile (read_text_file too: scenes, meshes, MTL
 /// and NFF files) is noted by its identity (device and inode), so that a command about to write
 /// can ask whether an output is one of its own inputs under another name (input_file_at). A
-/// command (`convert`, `check`) makes one; a library user's process, which may well rewrite a
-/// file it read earlier, makes none.
+/// command (`check`) makes one; so does loading an api::Scene, which keeps what it read (noted())
+/// for `render` and `convert` to ask the same of their outputs.
 class InputFilesNoted {
 public:
     InputFilesNoted();
     ~InputFilesNoted();
     InputFilesNoted(const InputFilesNoted&) = delete;
     InputFilesNoted& operator=(const InputFilesNoted&) = delete;
+
+    /// The files read (by any thread) since this one was made.
+    std::vector<NotedInput> noted() const;
+
+private:
+    size_t m_first = 0;
 };
 
 /// What `target` is among the files read while an InputFilesNoted lives ("the mesh file
 /// 'm.obj'"), or "" when it is none of them or does not exist.
 std::string input_file_at(const std::string& target);
+/// The same among `inputs`.
+std::string input_file_at(const std::string& target, const std::vector<NotedInput>& inputs);
 
 /// `text` made safe to print in a message: control characters (C0 such as ESC and BEL, DEL, and
 /// C1 such as U+009B) and bytes that are not UTF-8 (Latin-1 names) written as \xNN escapes, so a
