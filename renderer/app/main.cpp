@@ -510,6 +510,13 @@ int main(int argc, char** argv) {
         "whitted"};
     app.set_version_flag("--version", version_text);
     app.require_subcommand(1);
+    // CLI11's own refusals in the form of every other error, naming the command's --help. Set
+    // before the commands are added: each copies it when it is made.
+    app.failure_message([](const CLI::App* top, const CLI::Error& e) {
+        std::string help = "whitted";
+        for (const CLI::App* command : top->get_subcommands()) help += " " + command->get_name();
+        return "whitted: error: " + std::string(e.what()) + " (" + help + " --help)\n";
+    });
     app.footer(
         "Exit status: 0 success; 1 failure while rendering or checking (or images disagree);\n"
         "2 bad input or usage; 130/143 interrupted by SIGINT/SIGTERM.\n"
@@ -525,17 +532,27 @@ int main(int argc, char** argv) {
         (documentation_root().empty() ? std::string()
                                       : "\nThe docs/ and examples/ named here are in " + documentation_root() + "/."));
 
+    // A path given as '' is a mistake (an unset shell variable, say), not "no path": without this
+    // `--write-config ''` would do nothing and succeed, `--report ''` would write no report.
+    const CLI::Validator not_empty(
+        [](std::string& value) { return value.empty() ? std::string("an empty value; give a name") : std::string(); },
+        "", "not_empty");
+    // The scene, or - for standard input, with one reason when it is neither.
+    const CLI::Validator scene_or_stdin(
+        [](std::string& path) { return path == "-" ? std::string() : CLI::ExistingFile(path); }, "", "scene");
+
     RenderArguments render_args;
     CLI::App* render_cmd = app.add_subcommand(
         "render", "Render a scene file (YAML or JSON, format v1; a course .xml scene; an NFF .nff scene) to an image");
     render_cmd->add_option("scene", render_args.scene, "Scene file, or - to read the scene from standard input")
         ->required()
-        ->check(CLI::ExistingFile | CLI::IsMember({"-"}));
+        ->check(scene_or_stdin);
     render_cmd
         ->add_option("-o,--output", render_args.output,
                      "Output image: .exr is linear float (scene-referred); .png/.jpg/.tif go through the "
                      "OpenColorIO display transform")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(not_empty);
     render_cmd->add_option("-t,--threads", render_args.threads, "Worker threads (default: all cores)")
         ->check(CLI::Range(0, 4096));
     render_cmd->add_flag("-q,--quiet", render_args.quiet, "No progress bar and no summary line");
@@ -548,14 +565,20 @@ int main(int argc, char** argv) {
         ->add_option("--bit-depth", render_args.write.bit_depth,
                      "PNG/TIFF bits per channel, 8 or 16 (default: PNG 8, TIFF 16; JPEG is 8 only)")
         ->check(CLI::IsMember({8, 16}));
-    render_cmd->add_option("--ocio-config", render_args.write.ocio_config,
-                           "PNG/JPEG/TIFF: OpenColorIO config file (default: $OCIO, else the built-in config; "
-                           "`whitted colour --list` shows it)");
-    render_cmd->add_option("--display", render_args.write.display,
-                           "PNG/JPEG/TIFF: OCIO display, e.g. sRGB, 'Gamma 2.2', BT.1886, 'Display P3' "
-                           "(default: the config's default)");
-    render_cmd->add_option("--view", render_args.write.view,
-                           "PNG/JPEG/TIFF: OCIO view, e.g. Standard, Raw (default: the display's default)");
+    render_cmd
+        ->add_option("--ocio-config", render_args.write.ocio_config,
+                     "PNG/JPEG/TIFF: OpenColorIO config file (default: $OCIO, else the built-in config; "
+                     "`whitted colour --list` shows it)")
+        ->check(not_empty);
+    render_cmd
+        ->add_option("--display", render_args.write.display,
+                     "PNG/JPEG/TIFF: OCIO display, e.g. sRGB, 'Gamma 2.2', BT.1886, 'Display P3' "
+                     "(default: the config's default)")
+        ->check(not_empty);
+    render_cmd
+        ->add_option("--view", render_args.write.view,
+                     "PNG/JPEG/TIFF: OCIO view, e.g. Standard, Raw (default: the display's default)")
+        ->check(not_empty);
     render_cmd->add_flag("--stats", render_args.stats,
                          "Print the time of each stage (parse, load, BVH, render, write) and the BVH's memory");
     render_cmd->add_flag("--partial", render_args.partial,
@@ -640,9 +663,11 @@ int main(int argc, char** argv) {
     CLI::App* check_cmd = app.add_subcommand(
         "check", "Render a scene with Whitted and with POV-Ray (converted) and compare them pixel by pixel");
     check_cmd->add_option("scene", check_scene, "Scene file")->required()->check(CLI::ExistingFile);
-    check_cmd->add_option("--report", check_options.report_dir,
-                          "Write images, a difference heat map, metrics.json and report.html (open it from the disk: "
-                          "wipe, zoom, pixel probe; docs/validation.md) into this directory");
+    check_cmd
+        ->add_option("--report", check_options.report_dir,
+                     "Write images, a difference heat map, metrics.json and report.html (open it from the disk: "
+                     "wipe, zoom, pixel probe; docs/validation.md) into this directory")
+        ->check(not_empty);
     check_cmd
         ->add_option("--tolerance", check_options.tolerance_codes, "Per-channel tolerance in 16-bit codes (1/65535)")
         ->capture_default_str()
@@ -686,10 +711,14 @@ int main(int argc, char** argv) {
     colour_cmd->alias("color");
     colour_cmd->add_flag("--list", colour_list,
                          "Print each display and view, the colour space it writes and what that means");
-    colour_cmd->add_option("--ocio-config", colour_config,
-                           "With --list: this config (default: $OCIO, else the built-in config)");
-    colour_cmd->add_option("--write-config", colour_write,
-                           "Write the built-in config to this .ocio file (for oiiotool, Nuke, Blender, ...)");
+    colour_cmd
+        ->add_option("--ocio-config", colour_config,
+                     "With --list: this config (default: $OCIO, else the built-in config)")
+        ->check(not_empty);
+    colour_cmd
+        ->add_option("--write-config", colour_write,
+                     "Write the built-in config to this .ocio file (for oiiotool, Nuke, Blender, ...)")
+        ->check(not_empty);
     colour_cmd->require_option(1, 2);
 
     std::string compare_first, compare_second;

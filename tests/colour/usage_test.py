@@ -113,4 +113,18 @@ with tempfile.TemporaryDirectory() as work:
     expect_usage_error(["colour", "--list", "--ocio-config", "/etc/passwd"], work, ["/etc/passwd"], "colour --list bad config")
     expect_usage_error(["colour", "--ocio-config", "x.ocio"], work, ["--ocio-config goes with --list"], "colour no --list")
 
+    # A name given as '' (an unset shell variable) is refused, never taken for "not given": before,
+    # `colour --write-config ''` wrote nothing and exited 0, `check --report ''` wrote no report.
+    for args in (["render", bad_scene, "--output", ""], ["render", bad_scene, "--ocio-config", ""],
+                 ["render", bad_scene, "--display", ""], ["render", bad_scene, "--view", ""],
+                 ["check", bad_scene, "--report", ""], ["colour", "--write-config", ""],
+                 ["colour", "--list", "--ocio-config", ""]):
+        expect_usage_error(args, work, [f"{args[-2]}: an empty value", f"(whitted {args[0]} --help)"],
+                           " ".join(args[:1] + args[2:-1]) + " ''")
+    # CLI11's own refusals are in the same form, naming the command's help.
+    expect_usage_error(["render", os.path.join(work, "missing.yaml")], work,
+                       ["File does not exist", "(whitted render --help)"], "render a missing scene")
+    expect_usage_error(["render", "--threads", "x", bad_scene], work, ["--threads", "(whitted render --help)"],
+                       "render --threads x")
+
 failures.finish()
