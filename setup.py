@@ -7,6 +7,7 @@ whitted_oiio (Release, no tests, for this interpreter), and build_ext copies int
     whitted.libs/libwhitted.so.M.m    the library, under its SONAME
     whitted.libs/libwhitted_oiio.so   the plug-in libwhitted.so loads from its own folder
     whitted.libs/libwhitted_{exr,tiff,jpeg}.so   the writers of those formats, plug-ins likewise
+    whitted.libs/libwhitted_ocio.so   OpenColorIO's display transform, a plug-in likewise
     whitted.pyi                       the type stubs
 Everything is built under $WHITTED_PIP_BUILD_DIR (default: build-pip/ here), never in build/.
 CMake options can be added in $CMAKE_ARGS; the build's parallelism is $CMAKE_BUILD_PARALLEL_LEVEL
@@ -25,8 +26,9 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 ROOT = os.path.dirname(os.path.abspath(__file__))
-# The image writers built as plug-ins (renderer/src/output/format_plugins.h).
-PLUGIN_FORMATS = ("exr", "tiff", "jpeg")
+# The image writers built as plug-ins (renderer/src/output/format_plugins.h) and the
+# OpenColorIO display transform (renderer/src/output/ocio_plugin.h).
+PLUGIN_FORMATS = ("exr", "tiff", "jpeg", "ocio")
 BUILD = os.path.abspath(os.environ.get("WHITTED_PIP_BUILD_DIR") or os.path.join(ROOT, "build-pip"))
 CMAKE_BUILD = os.path.join(BUILD, "cmake")
 

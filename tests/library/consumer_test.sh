@@ -19,7 +19,8 @@ cmake --install "$build" --prefix "$prefix" >"$work/install.log"
 for f in include/whitted/whitted.h include/whitted/image.h include/whitted/progress.h include/whitted/version.h \
          "$libdir/cmake/Whitted/WhittedConfig.cmake" "$libdir/cmake/Whitted/WhittedConfigVersion.cmake" \
          "$libdir/pkgconfig/whitted.pc" bin/whitted "$libdir/libwhitted_oiio.so" \
-         "$libdir/libwhitted_live.so" "$libdir/libwhitted_exr.so" "$libdir/libwhitted_tiff.so" "$libdir/libwhitted_jpeg.so"; do
+         "$libdir/libwhitted_live.so" "$libdir/libwhitted_exr.so" "$libdir/libwhitted_tiff.so" "$libdir/libwhitted_jpeg.so" \
+         "$libdir/libwhitted_ocio.so"; do
   [ -e "$prefix/$f" ] || { echo "FAIL: $f not installed"; exit 1; }
 done
 ls "$prefix/$libdir/libwhitted.so.0.2" >/dev/null

@@ -45,6 +45,8 @@ dpkg-deb -c "$deb" | awk '{ print $6 }' | sed 's|^\./|/|' >"$work/files.txt"
 python_version=$("$python" -c 'import sys; print(f"{sys.version_info[0]}{sys.version_info[1]}")')
 for f in /usr/bin/whitted \
   "/usr/lib/$multiarch/libwhitted.so.${version%.*}" "/usr/lib/$multiarch/libwhitted_oiio.so" \
+  "/usr/lib/$multiarch/libwhitted_exr.so" "/usr/lib/$multiarch/libwhitted_tiff.so" \
+  "/usr/lib/$multiarch/libwhitted_jpeg.so" "/usr/lib/$multiarch/libwhitted_ocio.so" \
   "/usr/lib/$multiarch/cmake/Whitted/WhittedConfig.cmake" "/usr/lib/$multiarch/pkgconfig/whitted.pc" \
   /usr/include/whitted/whitted.h \
   "/usr/lib/python3/dist-packages/whitted.cpython-$python_version-$multiarch.so" \
@@ -68,7 +70,8 @@ program="$tree/usr/bin/whitted"
 "$program" --version | head -n 1 | grep -qx "whitted $version" || fail "--version: $("$program" --version)"
 "$program" --help | tail -n 1 | grep -qF "are in $tree/usr/share/whitted/." ||
   fail "--help does not name the installed docs: $("$program" --help | tail -n 1)"
-# A PNG needs the OpenImageIO plug-in, which the program loads from beside its libraries.
+# A PNG needs the OpenColorIO plug-in (its sRGB display transform), which the program loads from
+# beside its libraries.
 (cd "$work" && "$program" render "$tree/usr/share/whitted/examples/lecture/01-lambertian-sphere.yaml" \
   --width 64 -q -o sphere.png) || fail "render to PNG from the unpacked tree"
 [ "$(od -An -tx1 -N4 "$work/sphere.png" | tr -d ' ')" = 89504e47 ] || fail "sphere.png is not a PNG"

@@ -37,7 +37,8 @@ rm -rf "$work/build"
 
 site=$("$venv_python" -c 'import sysconfig; print(sysconfig.get_paths()["platlib"])')
 module=$(ls "$site"/whitted.cpython-*.so)
-for f in whitted.pyi whitted.libs/libwhitted_oiio.so; do
+# The plug-ins: OpenImageIO (check), the EXR/TIFF/JPEG writers and OpenColorIO's display transform.
+for f in whitted.pyi whitted.libs/libwhitted_{oiio,exr,tiff,jpeg,ocio}.so; do
   [[ -f "$site/$f" ]] || fail "$site/$f not installed"
 done
 sonames=("$site"/whitted.libs/libwhitted.so.*)
@@ -101,6 +102,8 @@ with open("/proc/self/maps") as f:
 libs = os.path.join(site, "whitted.libs")
 assert mapped and all(os.path.dirname(p) == libs for p in mapped), mapped
 assert any(p.endswith("libwhitted_oiio.so") for p in mapped), mapped
+# The PNG went through OpenColorIO's sRGB display transform, the plug-in beside the library.
+assert any(p.endswith("libwhitted_ocio.so") for p in mapped), mapped
 print("rendered", image.shape, "max", image.max(), "; check:", result.verdict, "; loaded", sorted(mapped))
 EOF
 

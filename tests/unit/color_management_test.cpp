@@ -148,6 +148,43 @@ TEST_F(BuiltinConfig, WrittenConfigLoadsAndGivesTheSameValues) {
     std::remove(path.c_str());
 }
 
+// What the built-in config makes is kept for the next transform asking the same; a config file,
+// or $OCIO set since, is read again each time (it may have changed).
+TEST_F(BuiltinConfig, OnlyTheBuiltinConfigIsReused) {
+    const std::string path = ::testing::TempDir() + "whitted-reread-test.ocio";
+    const auto write_config = [&](const std::string& first_display) {
+        std::string text = DisplayTransform::builtin_config_text();
+        const std::string active = "active_displays: [sRGB, Gamma 2.2, BT.1886, Display P3]";
+        const size_t at = text.find(active);
+        ASSERT_NE(at, std::string::npos) << text;
+        text.replace(at, active.size(),
+                     "active_displays: [" + first_display + (first_display == "sRGB" ? ", Gamma 2.2" : ", sRGB") +
+                         ", BT.1886, Display P3]");
+        std::FILE* file = std::fopen(path.c_str(), "w");
+        ASSERT_NE(file, nullptr);
+        ASSERT_EQ(std::fwrite(text.data(), 1, text.size(), file), text.size());
+        std::fclose(file);
+    };
+    const DisplayTransform first("", "", ""), again("", "", "");
+    EXPECT_EQ(again.display(), "sRGB");
+    std::vector<float> a = {0.18f, 0.5f, 0.002f}, b = a;
+    first.apply(a.data(), 1);
+    again.apply(b.data(), 1);
+    for (size_t k = 0; k < a.size(); ++k) EXPECT_EQ(a[k], b[k]);
+
+    write_config("sRGB");
+    EXPECT_EQ(DisplayTransform(path, "", "").display(), "sRGB");
+    write_config("Gamma 2.2");
+    EXPECT_EQ(DisplayTransform(path, "", "").display(), "Gamma 2.2");
+    ::setenv("OCIO", path.c_str(), 1);
+    const DisplayTransform from_env("", "", "");
+    ::unsetenv("OCIO");
+    EXPECT_EQ(from_env.config_source(), "$OCIO=" + path);
+    EXPECT_EQ(from_env.display(), "Gamma 2.2");
+    EXPECT_EQ(DisplayTransform("", "", "").display(), "sRGB");
+    std::remove(path.c_str());
+}
+
 TEST_F(BuiltinConfig, UnreadableConfigIsAUsageError) {
     EXPECT_THROW(DisplayTransform("/etc/passwd", "", ""), std::invalid_argument);
     EXPECT_THROW(DisplayTransform("/nonexistent/config.ocio", "", ""), std::invalid_argument);

@@ -1,426 +1,101 @@
 // SPDX-License-Identifier: MIT
+// DisplayTransform's side in the program: OpenColorIO itself is reached through the plug-in
+// lib/libwhitted_ocio.so (ocio_display.cpp; ocio_plugin.h says why).
 #include "output/color_management.h"
 
-#include "output/chromaticities.h"
+#include "core/plugin.h"
+#include "output/ocio_plugin.h"
 
-#include <OpenColorIO/OpenColorIO.h>
-#include <tbb/parallel_for.h>
-
-#include <algorithm>
-#include <array>
-#include <cmath>
 #include <cstdlib>
-#include <filesystem>
-#include <functional>
-#include <sstream>
+#include <map>
+#include <mutex>
 #include <stdexcept>
-#include <vector>
-
-namespace OCIO = OCIO_NAMESPACE;
+#include <utility>
 
 namespace whitted {
 namespace {
 
-constexpr const char* scene_linear_name = "Linear Rec.709 (sRGB)";
-
-/// A display colour space of the built-in config: `decode` (display code → display-linear
-/// light, the colour space's "to reference" direction) and, for other primaries than Rec.709,
-/// the matrix from them to Rec.709.
-OCIO::ColorSpaceRcPtr display_space(const char* name, const char* description, OCIO::ConstTransformRcPtr decode,
-                                    const Chromaticities* primaries) {
-    OCIO::ColorSpaceRcPtr space = OCIO::ColorSpace::Create(OCIO::REFERENCE_SPACE_SCENE);
-    space->setName(name);
-    space->setFamily("Display");
-    space->setDescription(description);
-    space->setEncoding("sdr-video");
-    if (!primaries) {
-        space->setTransform(decode, OCIO::COLORSPACE_DIR_TO_REFERENCE);
-        return space;
-    }
-    const Matrix3 to_rec709 = multiply(inverse(rgb_to_xyz(rec709_chromaticities)), rgb_to_xyz(*primaries));
-    double m44[16] = {};
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) m44[4 * i + j] = to_rec709[size_t(i)][size_t(j)];
-    m44[15] = 1.0;
-    OCIO::MatrixTransformRcPtr matrix = OCIO::MatrixTransform::Create();
-    matrix->setMatrix(m44);
-    OCIO::GroupTransformRcPtr group = OCIO::GroupTransform::Create();
-    group->appendTransform(decode->createEditableCopy());
-    group->appendTransform(matrix);
-    space->setTransform(group, OCIO::COLORSPACE_DIR_TO_REFERENCE);
-    return space;
-}
-
-OCIO::ConstTransformRcPtr srgb_curve() {
-    OCIO::ExponentWithLinearTransformRcPtr curve = OCIO::ExponentWithLinearTransform::Create();
-    curve->setGamma({2.4, 2.4, 2.4, 1.0});
-    curve->setOffset({0.055, 0.055, 0.055, 0.0});
-    return curve;
-}
-
-OCIO::ConstTransformRcPtr power_curve(double gamma) {
-    OCIO::ExponentTransformRcPtr curve = OCIO::ExponentTransform::Create();
-    curve->setValue({gamma, gamma, gamma, 1.0});
-    // Negative display-linear values have no code: clamp (the default), as a file would.
-    return curve;
-}
-
-OCIO::ConstConfigRcPtr make_builtin_config() {
-    OCIO::ConfigRcPtr config = OCIO::Config::Create();
-    config->setName("whitted-builtin");
-    config->setDescription(
-        "Whitted's built-in config: linear Rec.709 scene values; sRGB, Gamma 2.2, BT.1886 and Display P3 "
-        "displays, each with a Standard view (the display's encoding) and a Raw view (no conversion).");
-
-    OCIO::ColorSpaceRcPtr linear = OCIO::ColorSpace::Create();
-    linear->setName(scene_linear_name);
-    linear->setFamily("Scene-linear");
-    linear->setDescription("Scene-referred linear light with Rec.709 / sRGB primaries, D65: what Whitted renders.");
-    linear->setEncoding("scene-linear");
-    config->addColorSpace(linear);
-
-    config->addColorSpace(display_space("sRGB - Display",
-                                        "The sRGB piecewise curve (IEC 61966-2-1) on Rec.709 primaries, D65.",
-                                        srgb_curve(), nullptr));
-    config->addColorSpace(display_space("Gamma 2.2 Rec.709 - Display",
-                                        "A pure 2.2 power law on Rec.709 primaries, D65 (the Cornell course's "
-                                        "reference images).",
-                                        power_curve(2.2), nullptr));
-    config->addColorSpace(display_space("BT.1886 Rec.709 - Display",
-                                        "Rec.709 video as an ITU-R BT.1886 display shows it (black 0, white 1: a 2.4 "
-                                        "power law) on Rec.709 primaries, D65.",
-                                        power_curve(2.4), nullptr));
-    config->addColorSpace(display_space("Display P3 - Display",
-                                        "Apple's Display P3: the sRGB curve on P3-D65 (SMPTE EG 432-1) primaries.",
-                                        srgb_curve(), &display_p3_chromaticities));
-
-    OCIO::ColorSpaceRcPtr raw = OCIO::ColorSpace::Create();
-    raw->setName("Raw");
-    raw->setFamily("Utility");
-    raw->setDescription("No conversion: the linear Rec.709 values, clipped to the file's range.");
-    raw->setIsData(true);
-    config->addColorSpace(raw);
-
-    config->setRole(OCIO::ROLE_SCENE_LINEAR, scene_linear_name);
-    config->setRole(OCIO::ROLE_DEFAULT, scene_linear_name);
-    config->setRole(OCIO::ROLE_REFERENCE, scene_linear_name);
-    config->setRole(OCIO::ROLE_DATA, "Raw");
-    config->setRole("color_picking", "sRGB - Display");
-    const std::pair<const char*, const char*> displays[] = {{"sRGB", "sRGB - Display"},
-                                                            {"Gamma 2.2", "Gamma 2.2 Rec.709 - Display"},
-                                                            {"BT.1886", "BT.1886 Rec.709 - Display"},
-                                                            {"Display P3", "Display P3 - Display"}};
-    for (const auto& [display, space] : displays) {
-        config->addDisplayView(display, "Standard", space, "");
-        config->addDisplayView(display, "Raw", "Raw", "");
-    }
-    config->setActiveDisplays("sRGB, Gamma 2.2, BT.1886, Display P3");
-    config->setActiveViews("Standard, Raw");
-    config->validate();
-    return config;
-}
-
-std::string join(const std::vector<std::string>& names) {
-    std::string out;
-    for (const std::string& name : names) out += (out.empty() ? "" : ", ") + name;
-    return out;
-}
-
-std::vector<std::string> displays_of(const OCIO::ConstConfigRcPtr& config) {
-    std::vector<std::string> names;
-    for (int i = 0; i < config->getNumDisplays(); ++i) names.emplace_back(config->getDisplay(i));
-    return names;
-}
-
-std::vector<std::string> views_of(const OCIO::ConstConfigRcPtr& config, const std::string& display) {
-    std::vector<std::string> names;
-    for (int i = 0; i < config->getNumViews(display.c_str()); ++i)
-        names.emplace_back(config->getView(display.c_str(), i));
-    return names;
-}
-
-/// The file a FileTransform's `src` names, found as OpenColorIO finds it: an absolute path as it
-/// is, else the first search path (context variables expanded, relative to the config's folder)
-/// that holds it; empty when none does (OpenColorIO then reports it missing itself).
-std::filesystem::path file_transform_source(const OCIO::ConstConfigRcPtr& config, const char* src) {
-    const OCIO::ConstContextRcPtr context = config->getCurrentContext();
-    const std::filesystem::path name = context->resolveStringVar(src);
-    std::error_code error;
-    if (name.is_absolute()) return name;
-    for (int i = 0; i < config->getNumSearchPaths(); ++i) {
-        std::filesystem::path folder = context->resolveStringVar(config->getSearchPath(i));
-        if (folder.is_relative()) folder = std::filesystem::path(config->getWorkingDir()) / folder;
-        if (std::filesystem::exists(folder / name, error)) return folder / name;
-    }
-    return {};
-}
-
-/// Every FileTransform of the config, in its colour spaces, looks and view transforms (inside
-/// groups too), must name a regular file: OpenColorIO would wait forever on a FIFO and read a
-/// device such as /dev/zero without end when the transform is built.
-void refuse_file_transforms_from_special_files(const OCIO::ConstConfigRcPtr& config) {
-    std::function<void(const OCIO::ConstTransformRcPtr&)> walk = [&](const OCIO::ConstTransformRcPtr& transform) {
-        if (!transform) return;
-        if (const auto group = OCIO::DynamicPtrCast<const OCIO::GroupTransform>(transform)) {
-            for (int i = 0; i < group->getNumTransforms(); ++i) walk(group->getTransform(i));
-        } else if (const auto file = OCIO::DynamicPtrCast<const OCIO::FileTransform>(transform)) {
-            const std::filesystem::path path = file_transform_source(config, file->getSrc());
-            std::error_code error;
-            const auto status = std::filesystem::status(path, error);
-            if (!path.empty() && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
-                throw std::runtime_error("its FileTransform source '" + std::string(file->getSrc()) + "' ('" +
-                                         path.string() +
-                                         "') is not a regular file (a FIFO, socket, device or directory)");
-        }
-    };
-    for (int i = 0; i < config->getNumColorSpaces(OCIO::SEARCH_REFERENCE_SPACE_ALL, OCIO::COLORSPACE_ALL); ++i) {
-        const OCIO::ConstColorSpaceRcPtr space = config->getColorSpace(
-            config->getColorSpaceNameByIndex(OCIO::SEARCH_REFERENCE_SPACE_ALL, OCIO::COLORSPACE_ALL, i));
-        if (!space) continue;
-        walk(space->getTransform(OCIO::COLORSPACE_DIR_TO_REFERENCE));
-        walk(space->getTransform(OCIO::COLORSPACE_DIR_FROM_REFERENCE));
-    }
-    for (int i = 0; i < config->getNumLooks(); ++i) {
-        const OCIO::ConstLookRcPtr look = config->getLook(config->getLookNameByIndex(i));
-        if (!look) continue;
-        walk(look->getTransform());
-        walk(look->getInverseTransform());
-    }
-    for (int i = 0; i < config->getNumViewTransforms(); ++i) {
-        const OCIO::ConstViewTransformRcPtr view = config->getViewTransform(config->getViewTransformNameByIndex(i));
-        if (!view) continue;
-        walk(view->getTransform(OCIO::VIEWTRANSFORM_DIR_TO_REFERENCE));
-        walk(view->getTransform(OCIO::VIEWTRANSFORM_DIR_FROM_REFERENCE));
+/// The plug-in's function `name`; a plug-in that cannot be loaded is reported as a usage error
+/// before any work, as the writers' plug-ins are (format_writer).
+void* ocio_symbol(const char* name) {
+    try {
+        return plugin_symbol("libwhitted_ocio.so", name,
+                             "OpenColorIO's display transform, needed to write .png, .jpg and .tif files");
+    } catch (const std::runtime_error& e) {
+        throw std::invalid_argument(e.what());
     }
 }
 
-/// The config `config_path` names, else $OCIO's, else the built-in one; `source` says which.
-OCIO::ConstConfigRcPtr load_config(const std::string& config_path, std::string& source) {
+/// The built-in config is chosen when no config file is named and $OCIO is unset or empty.
+bool uses_builtin_config(const std::string& config_path) {
     const char* env = std::getenv("OCIO");
-    // OCIO reads a directory or a file that is no config as an empty YAML document and then says
-    // little, and it would wait forever on a FIFO (or read /dev/zero without end): only a regular
-    // file (or a link to one) is handed to it.
-    const auto check_file = [](const std::string& path) {
-        std::error_code error;
-        const auto status = std::filesystem::status(path, error);
-        if (!std::filesystem::exists(status)) throw std::runtime_error("no such file");
-        if (std::filesystem::is_directory(status)) throw std::runtime_error("it is a directory");
-        if (!std::filesystem::is_regular_file(status))
-            throw std::runtime_error("it is not a regular file (a FIFO, socket or device)");
-    };
-    const auto from_file = [&](const std::string& path) {
-        check_file(path);
-        const OCIO::ConstConfigRcPtr config = OCIO::Config::CreateFromFile(path.c_str());
-        refuse_file_transforms_from_special_files(config);
-        return config;
-    };
-    try {
-        if (!config_path.empty()) {
-            source = config_path;
-            return from_file(config_path);
-        }
-        if (env && *env) {
-            source = std::string("$OCIO=") + env;
-            return from_file(env);
-        }
-    } catch (const std::exception& e) {
-        throw std::invalid_argument(
-            "cannot load the OpenColorIO config " +
-            (config_path.empty() ? "from $OCIO='" + std::string(env) + "'" : "'" + config_path + "'") + ": " +
-            e.what());
-    }
-    source = "built-in";
-    return make_builtin_config();
+    return config_path.empty() && (!env || !*env);
 }
 
-OCIO::ConstCPUProcessorRcPtr make_processor(const OCIO::ConstConfigRcPtr& config, const std::string& display,
-                                            const std::string& view) {
-    try {
-        const OCIO::ConstProcessorRcPtr processor =
-            config->getProcessor(OCIO::ROLE_SCENE_LINEAR, display.c_str(), view.c_str(), OCIO::TRANSFORM_DIR_FORWARD);
-        return processor->getOptimizedCPUProcessor(OCIO::BIT_DEPTH_F32, OCIO::BIT_DEPTH_F32,
-                                                   OCIO::OPTIMIZATION_DEFAULT);
-    } catch (const OCIO::Exception& e) {
-        throw std::runtime_error(std::string("OpenColorIO cannot build the display transform: ") + e.what());
-    }
+/// What the plug-in made of the built-in config for a (display, view) request. That config
+/// cannot change while the process runs, and a render makes its display transform twice (when
+/// it checks its options, before any work, and again when it writes), a Python session once
+/// per image: building it again cost about 0.4 ms of CPU each time (docs/performance.md,
+/// "Start-up"). A config file is read again every time: it may have changed. Never destroyed:
+/// its processors belong to OpenColorIO, whose own statics may be gone at exit.
+struct BuiltinTransforms {
+    std::mutex mutex;
+    std::map<std::pair<std::string, std::string>, DisplayTransformParts> made;
+};
+
+BuiltinTransforms& builtin_transforms() {
+    static auto* transforms = new BuiltinTransforms;
+    return *transforms;
 }
 
-/// Display-linear light → display code, for each transfer function a file can declare.
-double encode(DisplayEncoding::Transfer transfer, double linear) {
-    switch (transfer) {
-        case DisplayEncoding::Transfer::srgb:
-            return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1 / 2.4) - 0.055;
-        case DisplayEncoding::Transfer::gamma22:
-            return std::pow(linear, 1 / 2.2);
-        case DisplayEncoding::Transfer::gamma24:
-            return std::pow(linear, 1 / 2.4);
-        case DisplayEncoding::Transfer::linear:
-        case DisplayEncoding::Transfer::unknown:
-            break;
+DisplayTransformParts make_parts(const std::string& config_path, const std::string& display, const std::string& view) {
+    const bool builtin = uses_builtin_config(config_path);
+    if (builtin) {
+        BuiltinTransforms& transforms = builtin_transforms();
+        const std::lock_guard lock(transforms.mutex);
+        if (const auto it = transforms.made.find({display, view}); it != transforms.made.end()) return it->second;
     }
-    return linear;
-}
-
-/// The inverse of encode().
-double decode(DisplayEncoding::Transfer transfer, double code) {
-    switch (transfer) {
-        case DisplayEncoding::Transfer::srgb:
-            return code <= 0.04045 ? code / 12.92 : std::pow((code + 0.055) / 1.055, 2.4);
-        case DisplayEncoding::Transfer::gamma22:
-            return std::pow(code, 2.2);
-        case DisplayEncoding::Transfer::gamma24:
-            return std::pow(code, 2.4);
-        case DisplayEncoding::Transfer::linear:
-        case DisplayEncoding::Transfer::unknown:
-            break;
+    DisplayTransformParts parts;
+    reinterpret_cast<MakeDisplayTransformFunction>(ocio_symbol("whitted_ocio_display_transform"))(config_path, display,
+                                                                                                  view, parts);
+    if (builtin) {
+        BuiltinTransforms& transforms = builtin_transforms();
+        const std::lock_guard lock(transforms.mutex);
+        transforms.made.emplace(std::make_pair(display, view), parts);
     }
-    return code;
-}
-
-/// Runs the transform on greys and on each primary and recognises the result: the transfer
-/// function whose codes the greys get (to 5e-4, a tenth of an 8-bit code's width and far less
-/// than the nearest two candidates differ by), then the primaries the decoded primaries are in
-/// (to 2e-3). Anything else (a filmic tone curve, a look, other primaries) is "unknown", and the
-/// file then records only the names.
-DisplayEncoding probe(const OCIO::ConstCPUProcessorRcPtr& cpu) {
-    const std::array<float, 6> greys = {0.001f, 0.01f, 0.05f, 0.18f, 0.5f, 0.9f};
-    std::vector<float> rgb;
-    for (const float v : greys) rgb.insert(rgb.end(), {v, v, v});
-    for (int c = 0; c < 3; ++c)
-        for (int k = 0; k < 3; ++k) rgb.push_back(c == k ? 0.5f : 0.0f);
-    OCIO::PackedImageDesc image(rgb.data(), long(rgb.size() / 3), 1, 3);
-    cpu->apply(image);
-
-    DisplayEncoding encoding;
-    using T = DisplayEncoding::Transfer;
-    for (const T transfer : {T::linear, T::srgb, T::gamma22, T::gamma24}) {
-        bool matches = true;
-        for (size_t i = 0; i < greys.size(); ++i)
-            for (size_t k = 0; k < 3; ++k)
-                matches &= std::abs(double(rgb[3 * i + k]) - encode(transfer, double(greys[i]))) < 5e-4;
-        if (matches) {
-            encoding.transfer = transfer;
-            break;
-        }
-    }
-    if (encoding.transfer == T::unknown) return encoding;
-    Matrix3 measured{};
-    for (size_t c = 0; c < 3; ++c)
-        for (size_t k = 0; k < 3; ++k)
-            measured[k][c] = decode(encoding.transfer, rgb[3 * (greys.size() + c) + k]) / 0.5;
-    const auto near = [&](const Matrix3& expected) {
-        for (size_t i = 0; i < 3; ++i)
-            for (size_t j = 0; j < 3; ++j)
-                if (std::abs(measured[i][j] - expected[i][j]) > 2e-3) return false;
-        return true;
-    };
-    const Matrix3 identity{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
-    const Matrix3 to_p3 = multiply(inverse(rgb_to_xyz(display_p3_chromaticities)), rgb_to_xyz(rec709_chromaticities));
-    if (near(identity))
-        encoding.primaries = DisplayEncoding::Primaries::rec709;
-    else if (near(to_p3))
-        encoding.primaries = DisplayEncoding::Primaries::display_p3;
-    return encoding;
+    return parts;
 }
 
 }  // namespace
 
-std::string DisplayEncoding::description() const {
-    std::string text;
-    switch (transfer) {
-        case Transfer::linear:
-            text = "linear (no transfer function)";
-            break;
-        case Transfer::srgb:
-            text = "sRGB transfer (IEC 61966-2-1)";
-            break;
-        case Transfer::gamma22:
-            text = "gamma 2.2";
-            break;
-        case Transfer::gamma24:
-            text = "gamma 2.4 (BT.1886)";
-            break;
-        case Transfer::unknown:
-            return "not a plain transfer function (the file records only the names)";
-    }
-    switch (primaries) {
-        case Primaries::rec709:
-            return text + ", Rec.709 primaries, D65 white";
-        case Primaries::display_p3:
-            return text + ", P3-D65 primaries, D65 white";
-        case Primaries::unknown:
-            break;
-    }
-    return text + ", other primaries (the file records only the names)";
-}
-
-struct DisplayTransform::Impl {
-    OCIO::ConstCPUProcessorRcPtr cpu;
-};
-
-DisplayTransform::DisplayTransform(const std::string& config_path, const std::string& display, const std::string& view)
-    : m_impl(std::make_unique<Impl>()) {
-    const OCIO::ConstConfigRcPtr config = load_config(config_path, m_source);
-    m_config_name = config->getName() ? config->getName() : "";
-    m_display = display.empty() ? config->getDefaultDisplay() : display;
-    const std::vector<std::string> displays = displays_of(config);
-    if (std::find(displays.begin(), displays.end(), m_display) == displays.end())
-        throw std::invalid_argument("OpenColorIO display '" + m_display + "' is not in the config (" + m_source +
-                                    "); displays: " + join(displays));
-    m_view = view.empty() ? config->getDefaultView(m_display.c_str()) : view;
-    const std::vector<std::string> views = views_of(config, m_display);
-    if (std::find(views.begin(), views.end(), m_view) == views.end())
-        throw std::invalid_argument("OpenColorIO view '" + m_view + "' is not a view of display '" + m_display +
-                                    "'; views: " + join(views));
-    m_colorspace = config->getDisplayViewColorSpaceName(m_display.c_str(), m_view.c_str());
-    m_impl->cpu = make_processor(config, m_display, m_view);
-    m_encoding = probe(m_impl->cpu);
+DisplayTransform::DisplayTransform(const std::string& config_path, const std::string& display,
+                                   const std::string& view) {
+    DisplayTransformParts parts = make_parts(config_path, display, view);
+    m_apply = std::move(parts.apply);
+    m_source = std::move(parts.source);
+    m_config_name = std::move(parts.config_name);
+    m_display = std::move(parts.display);
+    m_view = std::move(parts.view);
+    m_colorspace = std::move(parts.colorspace);
+    m_encoding = parts.encoding;
 }
 
 DisplayTransform::~DisplayTransform() = default;
 
 void DisplayTransform::apply(float* rgb, size_t pixel_count) const {
-    // OCIO's CPU processor may be applied from several threads at once: large buffers are cut
-    // into chunks that run on all cores (its sRGB curve calls powf per value: ~13 ms of CPU for
-    // a 1280x960 image); a small one stays on the calling thread.
-    constexpr size_t chunk = 32768;
-    tbb::parallel_for(size_t(0), (pixel_count + chunk - 1) / chunk, [&](size_t c) {
-        const size_t first = c * chunk, count = std::min(chunk, pixel_count - first);
-        OCIO::PackedImageDesc image(rgb + 3 * first, static_cast<long>(count), 1, 3);
-        m_impl->cpu->apply(image);
-    });
+    m_apply(rgb, pixel_count);
 }
 
 std::string DisplayTransform::builtin_config_text() {
-    std::ostringstream out;
-    make_builtin_config()->serialize(out);
-    return out.str();
+    std::string text;
+    reinterpret_cast<BuiltinConfigTextFunction>(ocio_symbol("whitted_ocio_builtin_config_text"))(text);
+    return text;
 }
 
 std::string DisplayTransform::describe_config(const std::string& config_path) {
-    std::string source;
-    const OCIO::ConstConfigRcPtr config = load_config(config_path, source);
-    std::ostringstream out;
-    out << "OpenColorIO config: " << source;
-    if (config->getName() && *config->getName()) out << " (" << config->getName() << ")";
-    out << "\nscene_linear: "
-        << config->getColorSpaceNameByIndex(config->getIndexForColorSpace(OCIO::ROLE_SCENE_LINEAR))
-        << "\ndefault: --display '" << config->getDefaultDisplay() << "' --view '"
-        << config->getDefaultView(config->getDefaultDisplay()) << "'\n";
-    for (const std::string& display : displays_of(config)) {
-        out << "display '" << display << "'\n";
-        for (const std::string& view : views_of(config, display)) {
-            const char* space = config->getDisplayViewColorSpaceName(display.c_str(), view.c_str());
-            std::string meaning;
-            try {
-                meaning = probe(make_processor(config, display, view)).description();
-            } catch (const std::exception& e) {
-                meaning = e.what();
-            }
-            out << "  view '" << view << "': colour space '" << space << "': " << meaning << "\n";
-        }
-    }
-    return out.str();
+    std::string text;
+    reinterpret_cast<DescribeConfigFunction>(ocio_symbol("whitted_ocio_describe_config"))(config_path, text);
+    return text;
 }
 
 }  // namespace whitted

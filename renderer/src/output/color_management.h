@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
-#include <memory>
+#include <cstddef>
+#include <functional>
 #include <string>
 
 namespace whitted {
@@ -20,7 +21,8 @@ struct DisplayEncoding {
     std::string description() const;
 };
 
-/// Turns scene-linear RGB into display-referred RGB through OpenColorIO.
+/// Turns scene-linear RGB into display-referred RGB through OpenColorIO, which is loaded (as the
+/// plug-in lib/libwhitted_ocio.so, output/ocio_plugin.h) the first time one is made.
 ///
 /// The config comes from `config_path` when given, else from $OCIO, else from the built-in
 /// config (OCIO 2.1 ships none; docs/colour.md describes it): scene_linear = linear Rec.709,
@@ -29,7 +31,8 @@ class DisplayTransform {
 public:
     /// Empty `display`/`view` mean the config's defaults. Throws std::invalid_argument (a usage
     /// error) for an unreadable config or unknown names (the message lists the known ones), and
-    /// std::runtime_error when OCIO cannot build the transform.
+    /// std::runtime_error when OCIO cannot build the transform; std::invalid_argument naming the
+    /// plug-in when it cannot be loaded.
     DisplayTransform(const std::string& config_path, const std::string& display, const std::string& view);
     ~DisplayTransform();
 
@@ -53,8 +56,7 @@ public:
     static std::string describe_config(const std::string& config_path);
 
 private:
-    struct Impl;
-    std::unique_ptr<Impl> m_impl;
+    std::function<void(float*, size_t)> m_apply;
     std::string m_source, m_config_name, m_display, m_view, m_colorspace;
     DisplayEncoding m_encoding;
 };
