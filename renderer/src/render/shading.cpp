@@ -309,7 +309,7 @@ void LectureShading::see_lights(const Ray* rays, const SurfaceHit* hits, const V
             counted[i] = seen.arrives;
             counts.shadow += tested[i];
         }
-        // With transmitting surfaces in the scene a shadow ray is a walk (shadow_filter), else a
+        // With transmitting surfaces in the scene a shadow ray is a walk (shadow_filters), else a
         // plain occlusion test.
         PacketArray<Color, packet_size> filter;
         if (m_transmits) {
