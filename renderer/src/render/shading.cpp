@@ -227,19 +227,38 @@ Color LectureShading::trace(const Ray& ray, int hits_so_far, RayCounts& counts) 
     return radiance;
 }
 
-Color LectureShading::shadow_filter(Ray shadow_ray) const {
+void LectureShading::shadow_filters(Ray* shadow_rays, const bool* tested, int count, Color* filter,
+                                    bool* blocked) const {
     // POV-Ray's walk: each surface met multiplies the light by its kt, and the search goes on
     // from the shadow window's width past it (RaySpans::shadow, at that surface); an opaque one
-    // ends it.
-    Color filter(1.0);
-    SurfaceHit hit;
-    while (shadow_ray.t_max > shadow_ray.t_min && m_accelerator.intersect(shadow_ray, hit)) {
-        const Color& kt = m_scene.materials[hit.material].kt;
-        if (is_zero(kt)) return Color(0.0);
-        filter = filter * kt;
-        shadow_ray.t_min = hit.t + m_spans.shadow(hit.point);
+    // ends it. The rays still walking take each step together, as a packet.
+    bool walking[packet_size];
+    int left = 0;
+    for (int i = 0; i < count; ++i) {
+        filter[i] = Color(1.0);
+        walking[i] = tested[i] && shadow_rays[i].t_max > shadow_rays[i].t_min;
+        left += walking[i];
     }
-    return filter;
+    PacketArray<SurfaceHit, packet_size> hits;
+    bool found[packet_size];
+    while (left > 0) {
+        m_accelerator.intersect_packet(shadow_rays, walking, count, hits.data(), found);
+        for (int i = 0; i < count; ++i) {
+            if (!walking[i]) continue;
+            bool ends = !found[i];
+            if (found[i]) {
+                const Color& kt = m_scene.materials[hits[i].material].kt;
+                ends = is_zero(kt);
+                filter[i] = ends ? Color(0.0) : filter[i] * kt;
+                shadow_rays[i].t_min = hits[i].t + m_spans.shadow(hits[i].point);
+            }
+            if (ends || !(shadow_rays[i].t_max > shadow_rays[i].t_min)) {
+                walking[i] = false;
+                --left;
+            }
+        }
+    }
+    for (int i = 0; i < count; ++i) blocked[i] = tested[i] && is_zero(filter[i]);
 }
 
 bool LectureShading::refract(const Ray& ray, const SurfaceHit& hit, const Vec3& normal, Interiors& interiors,
@@ -290,16 +309,14 @@ void LectureShading::see_lights(const Ray* rays, const SurfaceHit* hits, const V
             counted[i] = seen.arrives;
             counts.shadow += tested[i];
         }
-        // With transmitting surfaces in the scene a shadow ray is a walk (shadow_filter), else a
+        // With transmitting surfaces in the scene a shadow ray is a walk (shadow_filters), else a
         // plain occlusion test.
         PacketArray<Color, packet_size> filter;
         if (m_transmits) {
-            for (int i = 0; i < count; ++i) {
-                filter[i] = Color(1.0);
-                if (!active[i] || !tested[i]) continue;
-                filter[i] = shadow_filter(shadow_rays[i]);
-                blocked[i] = is_zero(filter[i]);
-            }
+            PacketArray<Ray, packet_size> walked;  // the walk moves t_min; the observer sees the ray as cast
+            for (int i = 0; i < count; ++i)
+                if (tested[i]) walked[i] = shadow_rays[i];
+            shadow_filters(walked.data(), tested, count, filter.data(), blocked);
         } else {
             m_accelerator.occluded_packet(shadow_rays.data(), tested, count, blocked);
         }

@@ -173,8 +173,10 @@ private:
     /// reflection. `interiors` becomes the refracted ray's.
     bool refract(const Ray& ray, const SurfaceHit& hit, const Vec3& normal, Interiors& interiors,
                  Vec3& direction) const;
-    /// The product of the kt of the surfaces along a shadow ray; 0 where an opaque one blocks it.
-    Color shadow_filter(Ray shadow_ray) const;
+    /// For each of `count` shadow rays with tested[i]: the product of the kt of the surfaces
+    /// along it, filter[i] (0 where an opaque one blocks it), and blocked[i] where that is 0.
+    /// The rays' t_min is moved past each surface met.
+    void shadow_filters(Ray* shadow_rays, const bool* tested, int count, Color* filter, bool* blocked) const;
 
     const Scene& m_scene;
     const Accelerator& m_accelerator;
