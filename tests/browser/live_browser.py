@@ -30,21 +30,14 @@ import numpy as np
 import OpenImageIO as oiio
 import yaml
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import Failures, fail, fresh_folder, run as run_program  # noqa: E402  (tests/harness.py)
+
 SCENE = "examples/lecture/05-blinn-phong-p10.yaml"
 DATA_LAYERS = ("N", "Ng", "P", "Z", "albedo", "objectId", "materialId", "hits")
 CHROMIUM = os.environ.get("WHITTED_CHROMIUM", "/usr/bin/chromium")
-problems = []
-
-
-def fail(message):
-    print("FAIL:", message)
-    sys.exit(1)
-
-
-def check(ok, message):
-    print(("ok    " if ok else "FAIL  ") + message)
-    if not ok:
-        problems.append(message)
+failures = Failures()
+check = failures.check
 
 
 def pixels(path):
@@ -90,7 +83,7 @@ def main():
         missing.append(f"playwright-core is not installed in {tools}: scripts/setup --with-test-tools runs npm ci")
     if missing:
         fail("the browser tests need Chromium, node and playwright-core:\n  " + "\n  ".join(missing))
-    shutil.rmtree(work, ignore_errors=True)
+    fresh_folder(work)
     shots = os.path.join(work, "screenshots")
     home = os.path.join(work, "home")
     for d in (shots, os.path.join(home, "tmp")):
@@ -118,8 +111,8 @@ def main():
         env = dict(os.environ, HOME=home, XDG_CONFIG_HOME=os.path.join(home, ".config"),
                    XDG_CACHE_HOME=os.path.join(home, ".cache"), XDG_DATA_HOME=os.path.join(home, ".local/share"),
                    TMPDIR=os.path.join(home, "tmp"), NODE_PATH=os.path.join(tools, "node_modules"))
-        run = subprocess.run(["node", os.path.join(source, "tests", "browser", "live_test.js"), address, scene, work,
-                              shots, CHROMIUM], env=env, timeout=240)
+        run = run_program(["node", os.path.join(source, "tests", "browser", "live_test.js"), address, scene, work,
+                           shots, CHROMIUM], expect=None, env=env, timeout=240, stdout=None, stderr=None)
         check(run.returncode == 0, f"live_test.js in Chromium (exit {run.returncode})")
         if run.returncode != 0:
             fail("the page did not do what it should (above)")
@@ -165,7 +158,7 @@ def main():
     with open(edited, "w") as f:
         yaml.safe_dump(document, f, sort_keys=False)
     for output in ("edited.exr", "edited.png"):
-        r = subprocess.run([whitted, "render", edited, "-q", "-o", os.path.join(work, output)])
+        r = run_program([whitted, "render", edited, "-q", "-o", os.path.join(work, output)], expect=None)
         if r.returncode != 0:
             fail(f"whitted render {edited} -o {output} exited {r.returncode}")
     # The page's second image, full resolution at one sample per pixel: `whitted render` of the
@@ -173,13 +166,13 @@ def main():
     document["image"]["samples"] = 1
     with open(os.path.join(work, "edited-1.yaml"), "w") as f:
         yaml.safe_dump(document, f, sort_keys=False)
-    r = subprocess.run([whitted, "render", os.path.join(work, "edited-1.yaml"), "-q", "-o",
-                        os.path.join(work, "edited-1.exr")])
+    r = run_program([whitted, "render", os.path.join(work, "edited-1.yaml"), "-q", "-o",
+                     os.path.join(work, "edited-1.exr")], expect=None)
     preview, rendered_1 = pixels(os.path.join(work, "served-preview.exr")), pixels(os.path.join(work, "edited-1.exr"))
     check(r.returncode == 0 and preview.shape == rendered_1.shape and np.array_equal(preview, rendered_1)
           and not np.array_equal(preview, pixels(os.path.join(work, "edited.exr"))),
           f"the preview level {preview.shape} equals `whitted render` with samples: 1 bit for bit (not the full image)")
-    r = subprocess.run([whitted, "render", scene, "-q", "-o", os.path.join(work, "original.png")])
+    r = run_program([whitted, "render", scene, "-q", "-o", os.path.join(work, "original.png")], expect=None)
     if r.returncode != 0:
         fail(f"whitted render {scene} exited {r.returncode}")
     served, rendered = pixels(os.path.join(work, "served.exr")), pixels(os.path.join(work, "edited.exr"))
@@ -200,8 +193,8 @@ def main():
             moved["lights"][i].update(light)
     with open(os.path.join(work, "edited-moved.yaml"), "w") as f:
         yaml.safe_dump(moved, f, sort_keys=False)
-    r = subprocess.run([whitted, "render", os.path.join(work, "edited-moved.yaml"), "-q", "-o",
-                        os.path.join(work, "edited-moved.png")])
+    r = run_program([whitted, "render", os.path.join(work, "edited-moved.yaml"), "-q", "-o",
+                     os.path.join(work, "edited-moved.png")], expect=None)
     moved_png = pixels(os.path.join(work, "page-moved.png"))
     check(r.returncode == 0 and np.array_equal(moved_png, pixels(os.path.join(work, "edited-moved.png")))
           and not np.array_equal(moved_png, pixels(os.path.join(work, "original.png"))),
@@ -210,7 +203,7 @@ def main():
     # The saved file renders to the image the page showed: whitted render, bit for bit.
     saved = os.path.join(work, "saved.yaml")
     # (The page's PNG is the edited file's, above: the same EXR gives the same PNG.)
-    r = subprocess.run([whitted, "render", saved, "-q", "-o", os.path.join(work, "saved.exr")])
+    r = run_program([whitted, "render", saved, "-q", "-o", os.path.join(work, "saved.exr")], expect=None)
     check(r.returncode == 0, f"whitted render saved.yaml -o saved.exr: exit {r.returncode}")
     check(np.array_equal(pixels(os.path.join(work, "saved.exr")), served),
           "the saved file's EXR equals the served EXR of the page's values bit for bit")
@@ -219,8 +212,8 @@ def main():
     # (its places in the file, `where`, and its name differ: the saved file is another file).
     explained = json.load(open(os.path.join(work, "explain.json")))
     check(explained["values"] == values, "the page explained the saved values")
-    r = subprocess.run([whitted, "explain", saved, "--pixel", f"{explained['x']},{explained['y']}", "--json"],
-                       capture_output=True, text=True)
+    r = run_program([whitted, "explain", saved, "--pixel", f"{explained['x']},{explained['y']}", "--json"],
+                    expect=None)
     check(r.returncode == 0, f"whitted explain saved.yaml: exit {r.returncode} {r.stderr}")
 
     def numbers(document):
@@ -236,7 +229,8 @@ def main():
           f"(ambient {cli_terms['layers']['ambient']}, light 1 {cli_terms['layers']['lights'][0]})")
 
     # The diffuse layer the page showed: `whitted render --layers diffuse`'s channels, bit for bit.
-    r = subprocess.run([whitted, "render", saved, "-q", "--layers", "diffuse", "-o", os.path.join(work, "layers.exr")])
+    r = run_program([whitted, "render", saved, "-q", "--layers", "diffuse", "-o", os.path.join(work, "layers.exr")],
+                    expect=None)
     check(r.returncode == 0, f"whitted render --layers diffuse: exit {r.returncode}")
     layers = oiio.ImageInput.open(os.path.join(work, "layers.exr"))
     names = list(layers.spec().channelnames)
@@ -251,8 +245,8 @@ def main():
 
     # The data layers as views: each served EXR holds the layer's channels exactly as `whitted
     # render --layers` writes them (bit for bit), beside the R, G, B the page shows of them.
-    r = subprocess.run([whitted, "render", saved, "-q", "--layers", ",".join(DATA_LAYERS), "-o",
-                        os.path.join(work, "data-layers.exr")])
+    r = run_program([whitted, "render", saved, "-q", "--layers", ",".join(DATA_LAYERS), "-o",
+                     os.path.join(work, "data-layers.exr")], expect=None)
     check(r.returncode == 0, f"whitted render --layers {','.join(DATA_LAYERS)}: exit {r.returncode}")
     rendered_data = oiio.ImageInput.open(os.path.join(work, "data-layers.exr"))
     rendered_names = list(rendered_data.spec().channelnames)
@@ -295,7 +289,7 @@ def main():
 
     # check: the verdict the page showed is `whitted check`'s for the saved file.
     checked = json.load(open(os.path.join(work, "check.json")))["result"]
-    r = subprocess.run([whitted, "check", saved, "-q"], capture_output=True, text=True)
+    r = run_program([whitted, "check", saved, "-q"], expect=None)
     verdict = r.stdout.strip().splitlines()[-1] if r.stdout.strip() else ""
     expected_figures = verdict.split(": ", 1)[-1]
     check(r.returncode in (0, 1) and verdict.startswith("PASS" if checked["passed"] else "FAIL")
@@ -307,15 +301,11 @@ def main():
     bad = original.replace("p: 10", "p: [10", 1)
     with open(scene, "w") as f:
         f.write(bad)
-    r = subprocess.run([whitted, "render", scene, "-q", "-o", os.path.join(work, "bad.png")], capture_output=True,
-                       text=True)
+    r = run_program([whitted, "render", scene, "-q", "-o", os.path.join(work, "bad.png")], expect=None)
     expected = r.stderr.strip().removeprefix("whitted: error: ")
     check(r.returncode == 2 and shown == expected, f"page error {shown!r} is render's {expected!r}")
 
-    if problems:
-        print(f"{len(problems)} problem(s)")
-        sys.exit(1)
-    print("all checks passed")
+    failures.finish("all checks passed")
 
 
 if __name__ == "__main__":
