@@ -40,7 +40,7 @@ WHITTED_API const char* version();
 /// What went wrong, and where: the scene file (or "<string>", or "<SceneBuilder>" with the
 /// number of the builder call as the line) and its 1-based line and column, 0 when unknown.
 struct Error {
-    std::string message;  ///< without the location
+    std::string message;    ///< without the location
     std::string file = {};  ///< the file the error is in, if any
     int line = 0, column = 0;
     /// bad_input: the caller's scene or options are wrong (`whitted` exits 2); failure: it went
