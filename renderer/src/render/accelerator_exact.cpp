@@ -129,6 +129,7 @@ void analytic_bounds(const RTCBoundsFunctionArguments* args) {
 void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
     const auto* geometry = static_cast<const AnalyticGeometry*>(args->geometryUserPtr);
     auto* context = reinterpret_cast<QueryContext*>(args->context);
+    if (context->gathering) return;  // nearest_triangle's query asks for triangles only
     RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, args->N);
     RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, args->N);
     for (unsigned i = 0; i < args->N; ++i) {
@@ -218,9 +219,84 @@ void triangle_filter(const RTCFilterFunctionNArguments* args) {
     }
 }
 
+void TriangleCandidates::add(const TriangleCandidate& candidate) {
+    if (count < capacity) {
+        nearest[count++] = candidate;
+        return;
+    }
+    TriangleCandidate* farthest = std::max_element(nearest, nearest + capacity);
+    if (candidate < *farthest) *farthest = candidate;
+}
+
+/// nearest_triangle's filter: every triangle candidate the double test accepts is gathered, and
+/// every one is refused, so that Embree goes on to all of them within the query's range.
+void gather_triangles(const RTCFilterFunctionNArguments* args) {
+    const auto* geometry = static_cast<const TriangleGeometry*>(args->geometryUserPtr);
+    const auto* context = reinterpret_cast<const QueryContext*>(args->context);
+    TriangleCandidates& gathered = *context->gathering;
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) continue;
+        args->valid[i] = 0;
+        const unsigned id = RTCRayN_id(args->ray, args->N, i);
+        if (!context->is_query(id)) continue;
+        const unsigned inst = RTCHitN_instID(args->hit, args->N, i, 0);
+        const bool instanced = inst != RTC_INVALID_GEOMETRY_ID;
+        const Ray ray =
+            instanced ? to_object_space(*(*geometry->instance_transforms)[inst], context->rays[id]) : context->rays[id];
+        const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+        ShapeHit hit;
+        if (!hit_triangle_in_double(*geometry->mesh, prim, ray, geometry->as_povray, instanced, hit)) continue;
+        const uint32_t object =
+            instanced ? gathered.scene->instances[(*gathered.mesh_of_geometry)[inst]].object : geometry->mesh->object;
+        gathered.add({hit.t, object, inst, RTCHitN_geomID(args->hit, args->N, i), prim});
+    }
+}
+
 }  // namespace accel
 
 using namespace accel;
+
+/// Which triangle the ray meets first, given the one Embree proposed, met at `t` by the double
+/// test. Embree chose it by its float distance, whose rounding differs between instruction
+/// sets (FMA or not, the packet width): where two triangles lie within that rounding of each
+/// other along the ray (coplanar faces of two overlapping gears, a shared edge), the order of
+/// their float distances is the instruction set's, not the scene's. So the triangles near `t`
+/// are gathered again in double (gather_triangles) and the choice is the exact rule's: the
+/// nearest double distance, and of those within tie_window of it the first object in the file
+/// (under POV-Ray's rules, of those at exactly that distance), then the nearest, then the
+/// lowest instance, mesh and triangle. Returns that triangle in `inst`, `geom`, `prim`.
+void Accelerator::Impl::nearest_triangle(const Ray& ray, double t, unsigned& inst, unsigned& geom,
+                                         unsigned& prim) const {
+    // Embree's float distance strays from the double one by a few ulps of the coordinates and
+    // distances involved (world_triangle_margin's 2^-24 (reach + span) each), more where the ray
+    // grazes the plane; the window takes 2^10 of them and a millionth of t, far beyond both.
+    const double stray = std::ldexp(frame.reach + frame.span, -14) + 1e-6 * t;
+    TriangleCandidates gathered;
+    gathered.scene = &scene;
+    gathered.mesh_of_geometry = &mesh_of_geometry;
+    QueryContext context(&ray, nullptr, 1, false);
+    context.embree.filter = gather_triangles;
+    context.gathering = &gathered;
+    context.start(0, ray);
+    RTCRayHit rayhit;
+    rayhit.ray = make_embree_ray(ray, 0, frame);
+    rayhit.ray.tnear = float(std::max(0.0, t - stray));
+    rayhit.ray.tfar = next_up(float(t + stray));
+    rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(rtc_scene, &context.embree, &rayhit);
+    if (gathered.count == 0) return;  // not expected: the proposed triangle is among them
+    const TriangleCandidate *begin = gathered.nearest, *end = begin + gathered.count;
+    const TriangleCandidate* chosen = std::min_element(begin, end);
+    const double nearest = chosen->t;
+    const double window = scene.intersection == Intersection::povray ? 0.0 : tie_window(ray, nearest);
+    for (const TriangleCandidate* c = begin; c != end; ++c)
+        if (c->t <= nearest + window &&
+            std::tie(c->object, c->t, c->inst, c->geom, c->prim) <
+                std::tie(chosen->object, chosen->t, chosen->inst, chosen->geom, chosen->prim))
+            chosen = c;
+    inst = chosen->inst, geom = chosen->geom, prim = chosen->prim;
+}
 
 const PovrayTestOrder& Accelerator::Impl::tie_order() const {
     // The threads that wait help build it (its sorts split work).
@@ -243,6 +319,20 @@ bool Accelerator::Impl::finish_hit(const Ray& ray, unsigned inst, unsigned geom,
     bool found = false;
     double t_max = ray.t_max;
     ShapeHit hit;
+    if (geom != RTC_INVALID_GEOMETRY_ID && (inst != RTC_INVALID_GEOMETRY_ID || kinds[geom] == ShapeKind::triangles)) {
+        // A triangle: decided in double, then settled against its near neighbours along the ray.
+        const bool instanced = inst != RTC_INVALID_GEOMETRY_ID;
+        const TriangleMesh& mesh =
+            instanced ? scene.prototypes[scene.instances[mesh_of_geometry[inst]].prototype].meshes[geom]
+                      : scene.meshes[mesh_of_geometry[geom]];
+        const bool as_povray = instanced
+                                   ? prototype_povray[scene.instances[mesh_of_geometry[inst]].prototype][geom].decided
+                                   : world_povray[mesh_of_geometry[geom]].decided;
+        const Ray local =
+            instanced ? to_object_space(scene.instances[mesh_of_geometry[inst]].object_to_world, ray) : ray;
+        if (!hit_triangle_in_double(mesh, prim, local, as_povray, instanced, hit)) return retry = true, false;
+        nearest_triangle(ray, hit.t, inst, geom, prim);
+    }
     if (geom != RTC_INVALID_GEOMETRY_ID) {
         if (inst != RTC_INVALID_GEOMETRY_ID) {
             // A prototype's triangle, tested in double in the prototype's space, its normals
