@@ -267,10 +267,7 @@ using namespace accel;
 /// lowest instance, mesh and triangle. Returns that triangle in `inst`, `geom`, `prim`.
 void Accelerator::Impl::nearest_triangle(const Ray& ray, double t, unsigned& inst, unsigned& geom,
                                          unsigned& prim) const {
-    // Embree's float distance strays from the double one by a few ulps of the coordinates and
-    // distances involved (world_triangle_margin's 2^-24 (reach + span) each), more where the ray
-    // grazes the plane; the window takes 2^10 of them and a millionth of t, far beyond both.
-    const double stray = std::ldexp(frame.reach + frame.span, -14) + 1e-6 * t;
+    const double stray = triangle_stray(t);
     TriangleCandidates gathered;
     gathered.scene = &scene;
     gathered.mesh_of_geometry = &mesh_of_geometry;
@@ -298,6 +295,37 @@ void Accelerator::Impl::nearest_triangle(const Ray& ray, double t, unsigned& ins
     inst = chosen->inst, geom = chosen->geom, prim = chosen->prim;
 }
 
+/// How far along `ray` (in its t) nearest_triangle looks on either side of a hit at `t`.
+/// Embree's float distance strays from the double one by a few ulps of the coordinates and
+/// distances involved (world_triangle_margin's 2^-24 (reach + span) each), more where the ray
+/// grazes the plane; the window takes 2^10 of them and a millionth of t, far beyond both.
+double Accelerator::Impl::triangle_stray(double t) const {
+    return std::ldexp(frame.reach + frame.span, -14) + 1e-6 * t;
+}
+
+/// Whether a ray that met top-level geometry `top` (a mesh of the world, or an instance) at
+/// `t` may have met another object's triangle within nearest_triangle's window of it: the hit
+/// lies within that window of the world box of a mesh or instance near `top`
+/// (find_tie_neighbours). Elsewhere no other object's triangle is near enough to tie, and the
+/// ray pays nothing for the settling. A window wider than the neighbours were found with is
+/// settled always.
+bool Accelerator::Impl::may_meet_another_object(const Ray& ray, unsigned top, double t) const {
+    const uint32_t begin = tie_neighbours_start[top], end = tie_neighbours_start[top + 1];
+    if (begin == end) return false;
+    const double window = triangle_stray(t) * length(ray.direction);
+    if (!(window <= tie_neighbour_margin)) return true;
+    const Vec3 x = ray.at(t);
+    // The hit point is rounded in double: the same relative pad as the boxes'.
+    const double grow = window + 1e-9 * std::max({std::fabs(x.x), std::fabs(x.y), std::fabs(x.z)});
+    for (uint32_t i = begin; i != end; ++i) {
+        const WorldBox& b = tie_neighbours[i];
+        if (x.x >= b.lo.x - grow && x.x <= b.hi.x + grow && x.y >= b.lo.y - grow && x.y <= b.hi.y + grow &&
+            x.z >= b.lo.z - grow && x.z <= b.hi.z + grow)
+            return true;
+    }
+    return false;
+}
+
 const PovrayTestOrder& Accelerator::Impl::tie_order() const {
     // The threads that wait help build it (its sorts split work).
     tbb::collaborative_call_once(tie_order_built, [&] { tie_order_data = std::make_unique<PovrayTestOrder>(scene); });
@@ -319,6 +347,7 @@ bool Accelerator::Impl::finish_hit(const Ray& ray, unsigned inst, unsigned geom,
     bool found = false;
     double t_max = ray.t_max;
     ShapeHit hit;
+    bool tested = false;  // `hit` holds the double test of triangle `prim`
     if (geom != RTC_INVALID_GEOMETRY_ID && (inst != RTC_INVALID_GEOMETRY_ID || kinds[geom] == ShapeKind::triangles)) {
         // A triangle: decided in double, then settled against its near neighbours along the ray.
         const bool instanced = inst != RTC_INVALID_GEOMETRY_ID;
@@ -331,7 +360,12 @@ bool Accelerator::Impl::finish_hit(const Ray& ray, unsigned inst, unsigned geom,
         const Ray local =
             instanced ? to_object_space(scene.instances[mesh_of_geometry[inst]].object_to_world, ray) : ray;
         if (!hit_triangle_in_double(mesh, prim, local, as_povray, instanced, hit)) return retry = true, false;
-        nearest_triangle(ray, hit.t, inst, geom, prim);
+        tested = true;
+        if (may_meet_another_object(ray, instanced ? inst : geom, hit.t)) {
+            const unsigned proposed[3] = {inst, geom, prim};
+            nearest_triangle(ray, hit.t, inst, geom, prim);
+            tested = inst == proposed[0] && geom == proposed[1] && prim == proposed[2];
+        }
     }
     if (geom != RTC_INVALID_GEOMETRY_ID) {
         if (inst != RTC_INVALID_GEOMETRY_ID) {
@@ -343,7 +377,8 @@ bool Accelerator::Impl::finish_hit(const Ray& ray, unsigned inst, unsigned geom,
             const Transform& to_world = instance.object_to_world;
             const TriangleMesh& mesh = scene.prototypes[instance.prototype].meshes[geom];
             const MeshAsPovray& povray = prototype_povray[instance.prototype][geom];
-            if (!hit_triangle_in_double(mesh, prim, to_object_space(to_world, ray), povray.decided, true, hit))
+            if (!tested &&
+                !hit_triangle_in_double(mesh, prim, to_object_space(to_world, ray), povray.decided, true, hit))
                 return retry = true, false;
             const double handedness = to_world.determinant() < 0 ? -1.0 : 1.0;
             out.geometric_normal = normalize(to_world.apply_normal(hit.normal)) * handedness;
@@ -358,7 +393,8 @@ bool Accelerator::Impl::finish_hit(const Ray& ray, unsigned inst, unsigned geom,
         } else if (kinds[geom] == ShapeKind::triangles) {
             const TriangleMesh& mesh = scene.meshes[mesh_of_geometry[geom]];
             const MeshAsPovray& povray = world_povray[mesh_of_geometry[geom]];
-            if (!hit_triangle_in_double(mesh, prim, ray, povray.decided, false, hit)) return retry = true, false;
+            if (!tested && !hit_triangle_in_double(mesh, prim, ray, povray.decided, false, hit))
+                return retry = true, false;
             out.geometric_normal = normalize(hit.normal);
             Vec3 smooth;
             out.normal = smooth_normal(mesh, prim, hit, povray, ray.at(hit.t), scene.convention, smooth)

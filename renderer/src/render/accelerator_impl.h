@@ -268,6 +268,20 @@ struct Accelerator::Impl {
     bool finish_hit(const Ray& ray, unsigned inst, unsigned geom, unsigned prim, double best_t, const Vec3& best_normal,
                     bool tied, SurfaceHit& out, bool& retry) const;
     void nearest_triangle(const Ray& ray, double t, unsigned& inst, unsigned& geom, unsigned& prim) const;
+    double triangle_stray(double t) const;
+    bool may_meet_another_object(const Ray& ray, unsigned top, double t) const;
+
+    /// Where a triangle's hit may tie with another object's triangle (find_tie_neighbours): for
+    /// each top-level geomID (a mesh of the world or an instance), the world boxes of the other
+    /// such geometries that come within 2 tie_neighbour_margin of its own, from
+    /// tie_neighbours[tie_neighbours_start[id]] up to tie_neighbours[tie_neighbours_start[id + 1]].
+    struct WorldBox {
+        Vec3 lo, hi;
+    };
+    std::vector<uint32_t> tie_neighbours_start;
+    std::vector<WorldBox> tie_neighbours;
+    double tie_neighbour_margin = 0;
+    void find_tie_neighbours();
     bool intersect(const Ray& ray, SurfaceHit& out) const;
     bool intersect_from_here(const Ray& ray, SurfaceHit& out) const;
     bool intersect_from_afar(const Ray& ray, SurfaceHit& out) const;
