@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
+#include <vector>
 
 namespace whitted {
 
@@ -109,6 +111,7 @@ Accelerator::Impl::Impl(const Scene& s, int threads, const std::string& instruct
         record(id, ShapeKind::triangles, m);
     }
     add_instances();
+    find_tie_neighbours();
     if (!scene.spheres.empty()) add_analytic(spheres, scene.spheres.size());
     if (!scene.boxes.empty()) add_analytic(boxes, scene.boxes.size());
     if (!scene.cones.empty()) add_analytic(cones, scene.cones.size());
@@ -242,6 +245,73 @@ void Accelerator::Impl::add_instances() {
         if (instance_transforms.size() <= id) instance_transforms.resize(id + 1, nullptr);
         instance_transforms[id] = &instance.object_to_world;
     }
+}
+
+/// Which meshes and instances come near enough each other that a ray may meet two of them
+/// within the float error nearest_triangle settles: their world boxes, each grown by
+/// tie_neighbour_margin, overlap. A sweep along the scene's longest axis finds the pairs. The
+/// margin is the window nearest_triangle gathers over (triangle_stray) for a ray of unit
+/// direction that has come the scene's span, twice over; a ray whose window is wider is
+/// settled whatever its neighbours (may_meet_another_object).
+void Accelerator::Impl::find_tie_neighbours() {
+    tie_neighbour_margin = 2 * (std::ldexp(frame.reach + frame.span, -14) + 1e-6 * frame.span);
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    std::vector<WorldBox> box(kinds.size(), WorldBox{Vec3(inf), Vec3(-inf)});
+    std::vector<uint32_t> top;  // the top-level geomIDs of triangles
+    for (uint32_t id = 0; id < kinds.size(); ++id) {
+        WorldBox& b = box[id];
+        const auto take = [&b](const Vec3& p) {
+            b.lo = Vec3(std::min(b.lo.x, p.x), std::min(b.lo.y, p.y), std::min(b.lo.z, p.z));
+            b.hi = Vec3(std::max(b.hi.x, p.x), std::max(b.hi.y, p.y), std::max(b.hi.z, p.z));
+        };
+        if (kinds[id] == ShapeKind::triangles) {
+            const TriangleMesh& mesh = scene.meshes[mesh_of_geometry[id]];
+            for (size_t v = 0; v < mesh.vertex_count(); ++v) take(mesh.vertex(v));
+        } else if (kinds[id] == ShapeKind::instances) {
+            const Instance& instance = scene.instances[mesh_of_geometry[id]];
+            const Prototype& prototype = scene.prototypes[instance.prototype];
+            for (int corner = 0; corner < 8; ++corner)
+                take(instance.object_to_world.apply_point({corner & 1 ? prototype.hi.x : prototype.lo.x,
+                                                           corner & 2 ? prototype.hi.y : prototype.lo.y,
+                                                           corner & 4 ? prototype.hi.z : prototype.lo.z}));
+        } else {
+            continue;
+        }
+        // The corners were rounded in double: a relative pad far above that.
+        const double pad = 1e-9 * std::max({std::fabs(b.lo.x), std::fabs(b.lo.y), std::fabs(b.lo.z), std::fabs(b.hi.x),
+                                            std::fabs(b.hi.y), std::fabs(b.hi.z)});
+        b.lo -= Vec3(pad), b.hi += Vec3(pad);
+        if (b.lo.x <= b.hi.x) top.push_back(id);  // a mesh of no vertex has no box
+    }
+    // Sweep along the axis the boxes spread furthest on, so that few pairs are looked at.
+    Vec3 lo(inf), hi(-inf);
+    for (uint32_t id : top)
+        lo = Vec3(std::min(lo.x, box[id].lo.x), std::min(lo.y, box[id].lo.y), std::min(lo.z, box[id].lo.z)),
+        hi = Vec3(std::max(hi.x, box[id].hi.x), std::max(hi.y, box[id].hi.y), std::max(hi.z, box[id].hi.z));
+    const Vec3 spread = hi - lo;
+    const int axis = spread.x >= spread.y && spread.x >= spread.z ? 0 : spread.y >= spread.z ? 1 : 2;
+    const auto along = [axis](const Vec3& p) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; };
+    std::sort(top.begin(), top.end(), [&](uint32_t a, uint32_t b) {
+        const double a_lo = along(box[a].lo), b_lo = along(box[b].lo);
+        return a_lo != b_lo ? a_lo < b_lo : a < b;
+    });
+    const double grow = 2 * tie_neighbour_margin;
+    std::vector<std::pair<uint32_t, uint32_t>> pairs;
+    for (size_t i = 0; i < top.size(); ++i) {
+        const WorldBox& a = box[top[i]];
+        for (size_t j = i + 1; j < top.size() && along(box[top[j]].lo) <= along(a.hi) + grow; ++j) {
+            const WorldBox& b = box[top[j]];
+            if (b.lo.x <= a.hi.x + grow && a.lo.x <= b.hi.x + grow && b.lo.y <= a.hi.y + grow &&
+                a.lo.y <= b.hi.y + grow && b.lo.z <= a.hi.z + grow && a.lo.z <= b.hi.z + grow)
+                pairs.emplace_back(top[i], top[j]), pairs.emplace_back(top[j], top[i]);
+        }
+    }
+    std::sort(pairs.begin(), pairs.end());
+    tie_neighbours_start.assign(kinds.size() + 1, 0);
+    for (const auto& pair : pairs) ++tie_neighbours_start[pair.first + 1];
+    for (size_t id = 0; id < kinds.size(); ++id) tie_neighbours_start[id + 1] += tie_neighbours_start[id];
+    tie_neighbours.reserve(pairs.size());
+    for (const auto& pair : pairs) tie_neighbours.push_back(box[pair.second]);
 }
 
 void Accelerator::Impl::add_analytic(AnalyticGeometry& user, size_t count) {

@@ -129,6 +129,7 @@ void analytic_bounds(const RTCBoundsFunctionArguments* args) {
 void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
     const auto* geometry = static_cast<const AnalyticGeometry*>(args->geometryUserPtr);
     auto* context = reinterpret_cast<QueryContext*>(args->context);
+    if (context->gathering) return;  // nearest_triangle's query asks for triangles only
     RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, args->N);
     RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, args->N);
     for (unsigned i = 0; i < args->N; ++i) {
@@ -218,9 +219,112 @@ void triangle_filter(const RTCFilterFunctionNArguments* args) {
     }
 }
 
+void TriangleCandidates::add(const TriangleCandidate& candidate) {
+    if (count < capacity) {
+        nearest[count++] = candidate;
+        return;
+    }
+    TriangleCandidate* farthest = std::max_element(nearest, nearest + capacity);
+    if (candidate < *farthest) *farthest = candidate;
+}
+
+/// nearest_triangle's filter: every triangle candidate the double test accepts is gathered, and
+/// every one is refused, so that Embree goes on to all of them within the query's range.
+void gather_triangles(const RTCFilterFunctionNArguments* args) {
+    const auto* geometry = static_cast<const TriangleGeometry*>(args->geometryUserPtr);
+    const auto* context = reinterpret_cast<const QueryContext*>(args->context);
+    TriangleCandidates& gathered = *context->gathering;
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) continue;
+        args->valid[i] = 0;
+        const unsigned id = RTCRayN_id(args->ray, args->N, i);
+        if (!context->is_query(id)) continue;
+        const unsigned inst = RTCHitN_instID(args->hit, args->N, i, 0);
+        const bool instanced = inst != RTC_INVALID_GEOMETRY_ID;
+        const Ray ray =
+            instanced ? to_object_space(*(*geometry->instance_transforms)[inst], context->rays[id]) : context->rays[id];
+        const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+        ShapeHit hit;
+        if (!hit_triangle_in_double(*geometry->mesh, prim, ray, geometry->as_povray, instanced, hit)) continue;
+        const uint32_t object =
+            instanced ? gathered.scene->instances[(*gathered.mesh_of_geometry)[inst]].object : geometry->mesh->object;
+        gathered.add({hit.t, object, inst, RTCHitN_geomID(args->hit, args->N, i), prim});
+    }
+}
+
 }  // namespace accel
 
 using namespace accel;
+
+/// Which triangle the ray meets first, given the one Embree proposed, met at `t` by the double
+/// test. Embree chose it by its float distance, whose rounding differs between instruction
+/// sets (FMA or not, the packet width): where two triangles lie within that rounding of each
+/// other along the ray (coplanar faces of two overlapping gears, a shared edge), the order of
+/// their float distances is the instruction set's, not the scene's. So the triangles near `t`
+/// are gathered again in double (gather_triangles) and the choice is the exact rule's: the
+/// nearest double distance, and of those within tie_window of it the first object in the file
+/// (under POV-Ray's rules, of those at exactly that distance), then the nearest, then the
+/// lowest instance, mesh and triangle. Returns that triangle in `inst`, `geom`, `prim`.
+void Accelerator::Impl::nearest_triangle(const Ray& ray, double t, unsigned& inst, unsigned& geom,
+                                         unsigned& prim) const {
+    const double stray = triangle_stray(t);
+    TriangleCandidates gathered;
+    gathered.scene = &scene;
+    gathered.mesh_of_geometry = &mesh_of_geometry;
+    QueryContext context(&ray, nullptr, 1, false);
+    context.embree.filter = gather_triangles;
+    context.gathering = &gathered;
+    context.start(0, ray);
+    RTCRayHit rayhit;
+    rayhit.ray = make_embree_ray(ray, 0, frame);
+    rayhit.ray.tnear = float(std::max(0.0, t - stray));
+    rayhit.ray.tfar = next_up(float(t + stray));
+    rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(rtc_scene, &context.embree, &rayhit);
+    if (gathered.count == 0) return;  // not expected: the proposed triangle is among them
+    const TriangleCandidate *begin = gathered.nearest, *end = begin + gathered.count;
+    const TriangleCandidate* chosen = std::min_element(begin, end);
+    const double nearest = chosen->t;
+    const double window = scene.intersection == Intersection::povray ? 0.0 : tie_window(ray, nearest);
+    for (const TriangleCandidate* c = begin; c != end; ++c)
+        if (c->t <= nearest + window &&
+            std::tie(c->object, c->t, c->inst, c->geom, c->prim) <
+                std::tie(chosen->object, chosen->t, chosen->inst, chosen->geom, chosen->prim))
+            chosen = c;
+    inst = chosen->inst, geom = chosen->geom, prim = chosen->prim;
+}
+
+/// How far along `ray` (in its t) nearest_triangle looks on either side of a hit at `t`.
+/// Embree's float distance strays from the double one by a few ulps of the coordinates and
+/// distances involved (world_triangle_margin's 2^-24 (reach + span) each), more where the ray
+/// grazes the plane; the window takes 2^10 of them and a millionth of t, far beyond both.
+double Accelerator::Impl::triangle_stray(double t) const {
+    return std::ldexp(frame.reach + frame.span, -14) + 1e-6 * t;
+}
+
+/// Whether a ray that met top-level geometry `top` (a mesh of the world, or an instance) at
+/// `t` may have met another object's triangle within nearest_triangle's window of it: the hit
+/// lies within that window of the world box of a mesh or instance near `top`
+/// (find_tie_neighbours). Elsewhere no other object's triangle is near enough to tie, and the
+/// ray pays nothing for the settling. A window wider than the neighbours were found with is
+/// settled always.
+bool Accelerator::Impl::may_meet_another_object(const Ray& ray, unsigned top, double t) const {
+    const uint32_t begin = tie_neighbours_start[top], end = tie_neighbours_start[top + 1];
+    if (begin == end) return false;
+    const double window = triangle_stray(t) * length(ray.direction);
+    if (!(window <= tie_neighbour_margin)) return true;
+    const Vec3 x = ray.at(t);
+    // The hit point is rounded in double: the same relative pad as the boxes'.
+    const double grow = window + 1e-9 * std::max({std::fabs(x.x), std::fabs(x.y), std::fabs(x.z)});
+    for (uint32_t i = begin; i != end; ++i) {
+        const WorldBox& b = tie_neighbours[i];
+        if (x.x >= b.lo.x - grow && x.x <= b.hi.x + grow && x.y >= b.lo.y - grow && x.y <= b.hi.y + grow &&
+            x.z >= b.lo.z - grow && x.z <= b.hi.z + grow)
+            return true;
+    }
+    return false;
+}
 
 const PovrayTestOrder& Accelerator::Impl::tie_order() const {
     // The threads that wait help build it (its sorts split work).
@@ -243,6 +347,26 @@ bool Accelerator::Impl::finish_hit(const Ray& ray, unsigned inst, unsigned geom,
     bool found = false;
     double t_max = ray.t_max;
     ShapeHit hit;
+    bool tested = false;  // `hit` holds the double test of triangle `prim`
+    if (geom != RTC_INVALID_GEOMETRY_ID && (inst != RTC_INVALID_GEOMETRY_ID || kinds[geom] == ShapeKind::triangles)) {
+        // A triangle: decided in double, then settled against its near neighbours along the ray.
+        const bool instanced = inst != RTC_INVALID_GEOMETRY_ID;
+        const TriangleMesh& mesh =
+            instanced ? scene.prototypes[scene.instances[mesh_of_geometry[inst]].prototype].meshes[geom]
+                      : scene.meshes[mesh_of_geometry[geom]];
+        const bool as_povray = instanced
+                                   ? prototype_povray[scene.instances[mesh_of_geometry[inst]].prototype][geom].decided
+                                   : world_povray[mesh_of_geometry[geom]].decided;
+        const Ray local =
+            instanced ? to_object_space(scene.instances[mesh_of_geometry[inst]].object_to_world, ray) : ray;
+        if (!hit_triangle_in_double(mesh, prim, local, as_povray, instanced, hit)) return retry = true, false;
+        tested = true;
+        if (may_meet_another_object(ray, instanced ? inst : geom, hit.t)) {
+            const unsigned proposed[3] = {inst, geom, prim};
+            nearest_triangle(ray, hit.t, inst, geom, prim);
+            tested = inst == proposed[0] && geom == proposed[1] && prim == proposed[2];
+        }
+    }
     if (geom != RTC_INVALID_GEOMETRY_ID) {
         if (inst != RTC_INVALID_GEOMETRY_ID) {
             // A prototype's triangle, tested in double in the prototype's space, its normals
@@ -253,7 +377,8 @@ bool Accelerator::Impl::finish_hit(const Ray& ray, unsigned inst, unsigned geom,
             const Transform& to_world = instance.object_to_world;
             const TriangleMesh& mesh = scene.prototypes[instance.prototype].meshes[geom];
             const MeshAsPovray& povray = prototype_povray[instance.prototype][geom];
-            if (!hit_triangle_in_double(mesh, prim, to_object_space(to_world, ray), povray.decided, true, hit))
+            if (!tested &&
+                !hit_triangle_in_double(mesh, prim, to_object_space(to_world, ray), povray.decided, true, hit))
                 return retry = true, false;
             const double handedness = to_world.determinant() < 0 ? -1.0 : 1.0;
             out.geometric_normal = normalize(to_world.apply_normal(hit.normal)) * handedness;
@@ -268,7 +393,8 @@ bool Accelerator::Impl::finish_hit(const Ray& ray, unsigned inst, unsigned geom,
         } else if (kinds[geom] == ShapeKind::triangles) {
             const TriangleMesh& mesh = scene.meshes[mesh_of_geometry[geom]];
             const MeshAsPovray& povray = world_povray[mesh_of_geometry[geom]];
-            if (!hit_triangle_in_double(mesh, prim, ray, povray.decided, false, hit)) return retry = true, false;
+            if (!tested && !hit_triangle_in_double(mesh, prim, ray, povray.decided, false, hit))
+                return retry = true, false;
             out.geometric_normal = normalize(hit.normal);
             Vec3 smooth;
             out.normal = smooth_normal(mesh, prim, hit, povray, ray.at(hit.t), scene.convention, smooth)

@@ -27,6 +27,7 @@
 #include <memory>
 #include <new>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -75,6 +76,9 @@ struct QueryContext {
     /// The material and object of the hit held, to tell such a tie from one that looks the same.
     uint32_t best_material[Accelerator::packet_size];
     uint32_t best_object[Accelerator::packet_size];
+    /// Set for nearest_triangle's query: its filter gathers the triangles the double test
+    /// accepts there, and the analytic callbacks stand aside.
+    struct TriangleCandidates* gathering = nullptr;
 
     /// A query starts with nothing held, up to the ray's own limit.
     void start(int id, const Ray& ray) {
@@ -82,6 +86,30 @@ struct QueryContext {
         best_edge_tie[id] = false;
         best_tied[id] = false;
     }
+};
+
+/// A triangle the double test accepted (nearest_triangle): its distance, its object and where
+/// it is, as finish_hit takes it (Embree's instance geomID or RTC_INVALID_GEOMETRY_ID, geomID,
+/// primID).
+struct TriangleCandidate {
+    double t;
+    uint32_t object;
+    unsigned inst, geom, prim;
+    bool operator<(const TriangleCandidate& o) const {
+        return std::tie(t, object, inst, geom, prim) < std::tie(o.t, o.object, o.inst, o.geom, o.prim);
+    }
+};
+
+/// The triangles gathered by gather_triangles for one ray: the nearest `capacity` of them, a
+/// set that does not depend on the order Embree meets them in.
+struct TriangleCandidates {
+    static constexpr int capacity = 16;
+    TriangleCandidate nearest[capacity];
+    int count = 0;
+    /// Where to find an instance's object: Scene::instances by Impl::mesh_of_geometry.
+    const Scene* scene = nullptr;
+    const std::vector<uint32_t>* mesh_of_geometry = nullptr;
+    void add(const TriangleCandidate& candidate);
 };
 
 struct AnalyticGeometry {
@@ -161,6 +189,7 @@ void analytic_bounds(const RTCBoundsFunctionArguments* args);
 void analytic_intersect(const RTCIntersectFunctionNArguments* args);
 void analytic_occluded(const RTCOccludedFunctionNArguments* args);
 void triangle_filter(const RTCFilterFunctionNArguments* args);
+void gather_triangles(const RTCFilterFunctionNArguments* args);
 
 }  // namespace accel
 
@@ -238,6 +267,21 @@ struct Accelerator::Impl {
     const PovrayTestOrder& tie_order() const;
     bool finish_hit(const Ray& ray, unsigned inst, unsigned geom, unsigned prim, double best_t, const Vec3& best_normal,
                     bool tied, SurfaceHit& out, bool& retry) const;
+    void nearest_triangle(const Ray& ray, double t, unsigned& inst, unsigned& geom, unsigned& prim) const;
+    double triangle_stray(double t) const;
+    bool may_meet_another_object(const Ray& ray, unsigned top, double t) const;
+
+    /// Where a triangle's hit may tie with another object's triangle (find_tie_neighbours): for
+    /// each top-level geomID (a mesh of the world or an instance), the world boxes of the other
+    /// such geometries that come within 2 tie_neighbour_margin of its own, from
+    /// tie_neighbours[tie_neighbours_start[id]] up to tie_neighbours[tie_neighbours_start[id + 1]].
+    struct WorldBox {
+        Vec3 lo, hi;
+    };
+    std::vector<uint32_t> tie_neighbours_start;
+    std::vector<WorldBox> tie_neighbours;
+    double tie_neighbour_margin = 0;
+    void find_tie_neighbours();
     bool intersect(const Ray& ray, SurfaceHit& out) const;
     bool intersect_from_here(const Ray& ray, SurfaceHit& out) const;
     bool intersect_from_afar(const Ray& ray, SurfaceHit& out) const;
