@@ -2,7 +2,6 @@
 #include "render/renderer.h"
 
 #include "core/packet_array.h"
-#include "render/camera.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
@@ -19,53 +18,17 @@ namespace whitted {
 
 Color render_pixel(const Scene& scene, const LectureShading& shading, int i, int j, RayCounts& counts) {
     const int n = scene.samples;
-    PacketArray<Ray, Accelerator::packet_size> rays;
-    PacketArray<Color, Accelerator::packet_size> radiance;
     Color sum(0.0);
-    int count = 0;
-    for (int b = 0; b < n; ++b) {
-        for (int a = 0; a < n; ++a) {
-            double x0, y0;
-            sample_position(i, j, a, b, n, scene.width, scene.height, x0, y0);
-            rays[count++] = camera_ray(scene, x0, y0);
-            if (count == Accelerator::packet_size || (a == n - 1 && b == n - 1)) {
-                shading.trace_packet(rays.data(), count, 0, radiance.data(), counts);
-                for (int k = 0; k < count; ++k) sum += radiance[k];
-                counts.camera += count;
-                count = 0;
-            }
-        }
-    }
+    for_each_pixel_sample_packet(scene, i, j, [&](const Ray* rays, int count) {
+        PacketArray<Color, Accelerator::packet_size> radiance;
+        shading.trace_packet(rays, count, 0, radiance.data(), counts);
+        for (int k = 0; k < count; ++k) sum += radiance[k];
+        counts.camera += count;
+    });
     return n == 1 ? sum : sum / double(n * n);
 }
 
 namespace {
-
-/// The camera rays of [x_begin, x_end) × [y_begin, y_end), one sample per pixel, in packets of
-/// 4×4 neighbouring pixels: `trace(rays, count, pixel_x, pixel_y)` is called once per packet.
-template <class TracePacket>
-void for_each_single_sample_packet(const Scene& scene, int x_begin, int x_end, int y_begin, int y_end,
-                                   TracePacket&& trace) {
-    constexpr int side = 4;
-    static_assert(side * side == Accelerator::packet_size);
-    for (int by = y_begin; by < y_end; by += side) {
-        for (int bx = x_begin; bx < x_end; bx += side) {
-            PacketArray<Ray, Accelerator::packet_size> rays;
-            int pixel_x[Accelerator::packet_size], pixel_y[Accelerator::packet_size];
-            int count = 0;
-            for (int y = by; y < std::min(by + side, y_end); ++y) {
-                for (int x = bx; x < std::min(bx + side, x_end); ++x) {
-                    double x0, y0;
-                    sample_position(x, y, 0, 0, 1, scene.width, scene.height, x0, y0);
-                    rays[count] = camera_ray(scene, x0, y0);
-                    pixel_x[count] = x, pixel_y[count] = y;
-                    ++count;
-                }
-            }
-            trace(rays.data(), count, pixel_x, pixel_y);
-        }
-    }
-}
 
 /// The pixels of [x_begin, x_end) × [y_begin, y_end) with one sample each, traced as packets of
 /// 4×4 neighbouring pixels; the same values render_pixel gives one by one.
@@ -108,28 +71,18 @@ void render_block_layers_single_sample(const Scene& scene, const LectureShading&
 void render_pixel_layers(const Scene& scene, const LectureShading& shading, LayerSet selection, int i, int j,
                          LayerRecorder& recorder, Image& image, RayCounts& counts) {
     const int n = scene.samples;
-    PacketArray<Ray, Accelerator::packet_size> rays;
-    PacketArray<Color, Accelerator::packet_size> radiance;
     PixelLayers pixel;
-    int count = 0;
     bool first = true;
-    for (int b = 0; b < n; ++b) {
-        for (int a = 0; a < n; ++a) {
-            double x0, y0;
-            sample_position(i, j, a, b, n, scene.width, scene.height, x0, y0);
-            rays[count++] = camera_ray(scene, x0, y0);
-            if (count == Accelerator::packet_size || (a == n - 1 && b == n - 1)) {
-                recorder.reset();
-                shading.trace_packet(rays.data(), count, 0, radiance.data(), counts, recorder);
-                for (int k = 0; k < count; ++k) {
-                    pixel.add_sample(recorder.lane(k), first);
-                    first = false;
-                }
-                counts.camera += count;
-                count = 0;
-            }
+    for_each_pixel_sample_packet(scene, i, j, [&](const Ray* rays, int count) {
+        PacketArray<Color, Accelerator::packet_size> radiance;
+        recorder.reset();
+        shading.trace_packet(rays, count, 0, radiance.data(), counts, recorder);
+        for (int k = 0; k < count; ++k) {
+            pixel.add_sample(recorder.lane(k), first);
+            first = false;
         }
-    }
+        counts.camera += count;
+    });
     pixel.finish(n * n);
     const size_t index = size_t(j) * scene.width + i;
     store_pixel_layers(pixel, selection, image.layers, index, &image.rgb[3 * index]);
@@ -152,36 +105,24 @@ void render_tile_layers(const Scene& scene, const LectureShading& shading, Layer
 
 std::vector<CameraPacket> camera_packets(const Scene& scene, int i, int j) {
     std::vector<CameraPacket> packets;
-    const int n = scene.samples;
-    if (n == 1) {
+    if (scene.samples == 1) {
         // render_block_single_sample's blocks: 4×4 from each 32×32 tile's corner, so at multiples of 4.
-        constexpr int side = 4;
-        const int bx = i / side * side, by = j / side * side;
-        CameraPacket packet;
-        for (int y = by; y < std::min(by + side, scene.height); ++y) {
-            for (int x = bx; x < std::min(bx + side, scene.width); ++x) {
-                double x0, y0;
-                sample_position(x, y, 0, 0, 1, scene.width, scene.height, x0, y0);
-                packet.rays.push_back(camera_ray(scene, x0, y0));
-                packet.sample.push_back(x == i && y == j ? 0 : -1);
-            }
-        }
-        packets.push_back(std::move(packet));
+        const int bx = i / 4 * 4, by = j / 4 * 4;
+        for_each_single_sample_packet(scene, bx, std::min(bx + 4, scene.width), by, std::min(by + 4, scene.height),
+                                      [&](const Ray* rays, int count, const int* pixel_x, const int* pixel_y) {
+                                          CameraPacket& packet = packets.emplace_back();
+                                          packet.rays.assign(rays, rays + count);
+                                          for (int k = 0; k < count; ++k)
+                                              packet.sample.push_back(pixel_x[k] == i && pixel_y[k] == j ? 0 : -1);
+                                      });
         return packets;
     }
-    CameraPacket packet;
-    for (int b = 0; b < n; ++b) {
-        for (int a = 0; a < n; ++a) {
-            double x0, y0;
-            sample_position(i, j, a, b, n, scene.width, scene.height, x0, y0);
-            packet.rays.push_back(camera_ray(scene, x0, y0));
-            packet.sample.push_back(b * n + a);
-            if (int(packet.rays.size()) == Accelerator::packet_size || (a == n - 1 && b == n - 1)) {
-                packets.push_back(std::move(packet));
-                packet = CameraPacket();
-            }
-        }
-    }
+    int sample = 0;
+    for_each_pixel_sample_packet(scene, i, j, [&](const Ray* rays, int count) {
+        CameraPacket& packet = packets.emplace_back();
+        packet.rays.assign(rays, rays + count);
+        for (int k = 0; k < count; ++k) packet.sample.push_back(sample++);
+    });
     return packets;
 }
 

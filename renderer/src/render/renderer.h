@@ -1,13 +1,16 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include "core/packet_array.h"
 #include "render/accelerator.h"
+#include "render/camera.h"
 #include "render/layers.h"
 #include "render/shading.h"
 #include "scene/scene.h"
 #include "whitted/image.h"
 #include "whitted/progress.h"
 
+#include <algorithm>
 #include <atomic>
 #include <functional>
 #include <optional>
@@ -77,6 +80,58 @@ RenderedTiles render(const Scene& scene, const Accelerator& accelerator, const R
 
 /// One pixel, all its samples averaged (box filter).
 Color render_pixel(const Scene& scene, const LectureShading& shading, int i, int j, RayCounts& counts);
+
+// The packets render() traces its camera rays in. Every caller that must give render()'s values
+// bit for bit (the layers, the shading cache, `whitted explain`) forms them here, since a ray's
+// packet mates change the order of Embree's candidates and so, at a tie, its hit.
+
+/// Pixel (i, j)'s n×n camera rays (n = scene.samples), row by row, in packets of up to
+/// Accelerator::packet_size: `trace(rays, count)` once per packet, in order.
+template <class TracePacket>
+void for_each_pixel_sample_packet(const Scene& scene, int i, int j, TracePacket&& trace) {
+    const int n = scene.samples;
+    PacketArray<Ray, Accelerator::packet_size> rays;
+    int count = 0;
+    for (int b = 0; b < n; ++b) {
+        for (int a = 0; a < n; ++a) {
+            double x0, y0;
+            sample_position(i, j, a, b, n, scene.width, scene.height, x0, y0);
+            rays[count++] = camera_ray(scene, x0, y0);
+            if (count == Accelerator::packet_size || (a == n - 1 && b == n - 1)) {
+                trace(static_cast<const Ray*>(rays.data()), count);
+                count = 0;
+            }
+        }
+    }
+}
+
+/// The camera rays of [x_begin, x_end) × [y_begin, y_end), one sample per pixel, in packets of
+/// 4×4 neighbouring pixels from the corner (render() starts each at a multiple of 4):
+/// `trace(rays, count, pixel_x, pixel_y)` once per packet.
+template <class TracePacket>
+void for_each_single_sample_packet(const Scene& scene, int x_begin, int x_end, int y_begin, int y_end,
+                                   TracePacket&& trace) {
+    constexpr int side = 4;
+    static_assert(side * side == Accelerator::packet_size);
+    for (int by = y_begin; by < y_end; by += side) {
+        for (int bx = x_begin; bx < x_end; bx += side) {
+            PacketArray<Ray, Accelerator::packet_size> rays;
+            int pixel_x[Accelerator::packet_size], pixel_y[Accelerator::packet_size];
+            int count = 0;
+            for (int y = by; y < std::min(by + side, y_end); ++y) {
+                for (int x = bx; x < std::min(bx + side, x_end); ++x) {
+                    double x0, y0;
+                    sample_position(x, y, 0, 0, 1, scene.width, scene.height, x0, y0);
+                    rays[count] = camera_ray(scene, x0, y0);
+                    pixel_x[count] = x, pixel_y[count] = y;
+                    ++count;
+                }
+            }
+            trace(static_cast<const Ray*>(rays.data()), count, static_cast<const int*>(pixel_x),
+                  static_cast<const int*>(pixel_y));
+        }
+    }
+}
 
 /// The camera rays render() traces together in one packet, and which of them are pixel (i, j)'s.
 struct CameraPacket {

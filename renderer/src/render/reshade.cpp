@@ -2,7 +2,6 @@
 #include "render/reshade.h"
 
 #include "core/packet_array.h"
-#include "render/camera.h"
 #include "render/renderer.h"
 #include "render/shading.h"
 
@@ -143,7 +142,6 @@ ShadingCache ShadingCache::record(const Scene& scene, const Accelerator& acceler
         const TileRect rect = render_tile_rect(scene.width, scene.height, t);
         Tile tile = empty_tile();
         PathRecorder recorder(Accelerator::packet_size);
-        PacketArray<Ray, Accelerator::packet_size> rays;
         PacketArray<Color, Accelerator::packet_size> radiance;
         RayCounts counts;
         const auto store = [&](int x, int y, const Color& c) {
@@ -151,48 +149,30 @@ ShadingCache ShadingCache::record(const Scene& scene, const Accelerator& acceler
             out[0] = float(c.x), out[1] = float(c.y), out[2] = float(c.z);
         };
         if (n == 1) {
-            // The render's packets: 4×4 pixels from the tile's corner (render_block_single_sample).
-            constexpr int side = 4;
-            for (int by = rect.y_begin; by < rect.y_end; by += side)
-                for (int bx = rect.x_begin; bx < rect.x_end; bx += side) {
-                    int count = 0, px[Accelerator::packet_size], py[Accelerator::packet_size];
-                    for (int y = by; y < std::min(by + side, rect.y_end); ++y)
-                        for (int x = bx; x < std::min(bx + side, rect.x_end); ++x) {
-                            double x0, y0;
-                            sample_position(x, y, 0, 0, 1, scene.width, scene.height, x0, y0);
-                            rays[count] = camera_ray(scene, x0, y0);
-                            px[count] = x, py[count] = y, ++count;
-                        }
+            for_each_single_sample_packet(
+                scene, rect.x_begin, rect.x_end, rect.y_begin, rect.y_end,
+                [&](const Ray* rays, int count, const int* px, const int* py) {
                     recorder.reset();
-                    shading.trace_packet(rays.data(), count, 0, radiance.data(), counts, recorder);
+                    shading.trace_packet(rays, count, 0, radiance.data(), counts, recorder);
                     for (int k = 0; k < count; ++k) {
                         store(px[k], py[k], radiance[k]);
                         if (!keep) continue;
                         tile.pixel.push_back(uint32_t(py[k]) * uint32_t(scene.width) + uint32_t(px[k]));
                         recorder.append(k, tile);
                     }
-                }
+                });
         } else {
-            // render_pixel's packets: a pixel's n×n samples, row by row, 16 at a time.
             for (int y = rect.y_begin; y < rect.y_end; ++y)
                 for (int x = rect.x_begin; x < rect.x_end; ++x) {
                     Color sum(0.0);
-                    int count = 0;
-                    for (int b = 0; b < n; ++b)
-                        for (int a = 0; a < n; ++a) {
-                            double x0, y0;
-                            sample_position(x, y, a, b, n, scene.width, scene.height, x0, y0);
-                            rays[count++] = camera_ray(scene, x0, y0);
-                            if (count == Accelerator::packet_size || (a == n - 1 && b == n - 1)) {
-                                recorder.reset();
-                                shading.trace_packet(rays.data(), count, 0, radiance.data(), counts, recorder);
-                                for (int k = 0; k < count; ++k) {
-                                    sum += radiance[k];
-                                    if (keep) recorder.append(k, tile);
-                                }
-                                count = 0;
-                            }
+                    for_each_pixel_sample_packet(scene, x, y, [&](const Ray* rays, int count) {
+                        recorder.reset();
+                        shading.trace_packet(rays, count, 0, radiance.data(), counts, recorder);
+                        for (int k = 0; k < count; ++k) {
+                            sum += radiance[k];
+                            if (keep) recorder.append(k, tile);
                         }
+                    });
                     store(x, y, sum / double(n * n));
                     if (keep) tile.pixel.push_back(uint32_t(y) * uint32_t(scene.width) + uint32_t(x));
                 }
