@@ -32,10 +32,10 @@ import yaml
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from harness import Failures, fail, fresh_folder, run as run_program  # noqa: E402  (tests/harness.py)
+from browser_tools import CHROMIUM, chromium_env, require_tools  # noqa: E402  (beside this file)
 
 SCENE = "examples/lecture/05-blinn-phong-p10.yaml"
 DATA_LAYERS = ("N", "Ng", "P", "Z", "albedo", "objectId", "materialId", "hits")
-CHROMIUM = os.environ.get("WHITTED_CHROMIUM", "/usr/bin/chromium")
 failures = Failures()
 check = failures.check
 
@@ -74,15 +74,7 @@ def post(port, route, body, headers=None):
 
 def main():
     whitted, source, work, tools = sys.argv[1:5]
-    missing = []
-    if not os.access(CHROMIUM, os.X_OK):
-        missing.append(f"{CHROMIUM} is missing: apt-get install chromium (scripts/setup --with-test-tools does)")
-    if not shutil.which("node"):
-        missing.append("node is missing: apt-get install nodejs (scripts/setup --with-test-tools does)")
-    if not os.path.isfile(os.path.join(tools, "node_modules", "playwright-core", "package.json")):
-        missing.append(f"playwright-core is not installed in {tools}: scripts/setup --with-test-tools runs npm ci")
-    if missing:
-        fail("the browser tests need Chromium, node and playwright-core:\n  " + "\n  ".join(missing))
+    require_tools(tools)
     fresh_folder(work)
     shots = os.path.join(work, "screenshots")
     home = os.path.join(work, "home")
@@ -108,9 +100,7 @@ def main():
         check(status(port, {"Host": own, "Origin": "http://evil.example"}) == 403, "Origin http://evil.example: 403")
         check(status(port, {"Host": f"evil.example:{port}"}) == 403, "Host evil.example (DNS rebinding): 403")
 
-        env = dict(os.environ, HOME=home, XDG_CONFIG_HOME=os.path.join(home, ".config"),
-                   XDG_CACHE_HOME=os.path.join(home, ".cache"), XDG_DATA_HOME=os.path.join(home, ".local/share"),
-                   TMPDIR=os.path.join(home, "tmp"), NODE_PATH=os.path.join(tools, "node_modules"))
+        env = chromium_env(home, tools)
         run = run_program(["node", os.path.join(source, "tests", "browser", "live_test.js"), address, scene, work,
                            shots, CHROMIUM], expect=None, env=env, timeout=240, stdout=None, stderr=None)
         check(run.returncode == 0, f"live_test.js in Chromium (exit {run.returncode})")

@@ -28,11 +28,10 @@ import OpenImageIO as oiio
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from harness import fail, fresh_folder, run  # noqa: E402  (tests/harness.py)
+from browser_tools import CHROMIUM, chromium_env, require_tools  # noqa: E402  (beside this file)
 
 SCENE = "tests/pov/three_coloured_lights.yaml"
 REFERENCE = "tests/image/ref/three_coloured_lights.png"  # POV-Ray's render, exposure 1 (references.txt)
-# Debian's; $WHITTED_CHROMIUM only for browser.missing_tools, which shows a missing one fails.
-CHROMIUM = os.environ.get("WHITTED_CHROMIUM", "/usr/bin/chromium")
 
 
 def read(path):
@@ -50,18 +49,6 @@ def read(path):
 def codes(v):
     """As `whitted check` prints codes: one decimal of value x 65535, rounded half to even."""
     return f"{float(v) * 65535:.1f}"
-
-
-def tools_problem(tools):
-    problems = []
-    if not os.access(CHROMIUM, os.X_OK):
-        problems.append(f"{CHROMIUM} is missing: apt-get install chromium (scripts/setup --with-test-tools does)")
-    if not shutil.which("node"):
-        problems.append("node is missing: apt-get install nodejs (scripts/setup --with-test-tools does)")
-    if not os.path.isfile(os.path.join(tools, "node_modules", "playwright-core", "package.json")):
-        problems.append(f"playwright-core is not installed in {tools}: scripts/setup --with-test-tools runs "
-                        "npm ci there from tests/browser/package-lock.json")
-    return problems
 
 
 def expectations_for_report(report, layers_wanted):
@@ -189,9 +176,7 @@ def main():
         print(__doc__)
         sys.exit(2)
     whitted, source, work, tools, case = sys.argv[1:]
-    problems = tools_problem(tools)
-    if problems:
-        fail("the browser tests need Chromium, node and playwright-core:\n  " + "\n  ".join(problems))
+    require_tools(tools)
     fresh_folder(work)
     shots = os.path.join(work, "screenshots")
     os.makedirs(shots)
@@ -225,13 +210,7 @@ def main():
     expect_file = os.path.join(work, "expect.json")
     with open(expect_file, "w") as f:
         json.dump(expect, f, indent=1)
-    # Chromium's profile, caches and crash dumps under the build tree, never in the user's HOME.
-    home = os.path.join(work, "home")
-    for d in ("", ".config", ".cache", ".local/share", "tmp"):
-        os.makedirs(os.path.join(home, d), exist_ok=True)
-    env = dict(os.environ, HOME=home, XDG_CONFIG_HOME=os.path.join(home, ".config"),
-               XDG_CACHE_HOME=os.path.join(home, ".cache"), XDG_DATA_HOME=os.path.join(home, ".local/share"),
-               TMPDIR=os.path.join(home, "tmp"), NODE_PATH=os.path.join(tools, "node_modules"))
+    env = chromium_env(os.path.join(work, "home"), tools)
     start = time.monotonic()
     browser = run(["node", os.path.join(source, "tests", "browser", "report_test.js"), case, page, expect_file,
                    shots, CHROMIUM], expect=None, env=env, timeout=120, stdout=None, stderr=None)
