@@ -197,25 +197,31 @@ void analytic_occluded(const RTCOccludedFunctionNArguments* args) {
     }
 }
 
+/// Filter call `args`'s candidate `i` (a triangle) by the double test, on the ray as its mesh
+/// sees it (brought into the prototype for an instance's): true, with `hit`, when it is met.
+bool candidate_met_in_double(const RTCFilterFunctionNArguments* args, unsigned i, ShapeHit& hit) {
+    const auto* geometry = static_cast<const TriangleGeometry*>(args->geometryUserPtr);
+    const auto* context = reinterpret_cast<const QueryContext*>(args->context);
+    const unsigned id = RTCRayN_id(args->ray, args->N, i);
+    const unsigned inst = RTCHitN_instID(args->hit, args->N, i, 0);
+    const bool instanced = inst != RTC_INVALID_GEOMETRY_ID;
+    const Ray ray =
+        instanced ? to_object_space(*(*geometry->instance_transforms)[inst], context->rays[id]) : context->rays[id];
+    return hit_triangle_in_double(*geometry->mesh, RTCHitN_primID(args->hit, args->N, i), ray, geometry->as_povray,
+                                  instanced, hit);
+}
+
 /// Embree's filter for triangle candidates (hit_triangle_in_double): on the meshes' own
 /// geometry where every candidate must be decided as it is met (EmbreeFrame::exact_range);
 /// otherwise on the context of shadow rays (whose first accepted candidate ends the search)
 /// and of a ray traced again after its nearest candidate was refused.
 void triangle_filter(const RTCFilterFunctionNArguments* args) {
-    const auto* geometry = static_cast<const TriangleGeometry*>(args->geometryUserPtr);
     const auto* context = reinterpret_cast<const QueryContext*>(args->context);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
-        const unsigned id = RTCRayN_id(args->ray, args->N, i);
-        if (!context->is_query(id)) continue;
-        const unsigned inst = RTCHitN_instID(args->hit, args->N, i, 0);
-        const Ray ray = inst == RTC_INVALID_GEOMETRY_ID
-                            ? context->rays[id]
-                            : to_object_space(*(*geometry->instance_transforms)[inst], context->rays[id]);
+        if (!context->is_query(RTCRayN_id(args->ray, args->N, i))) continue;
         ShapeHit hit;
-        if (!hit_triangle_in_double(*geometry->mesh, RTCHitN_primID(args->hit, args->N, i), ray, geometry->as_povray,
-                                    inst != RTC_INVALID_GEOMETRY_ID, hit))
-            args->valid[i] = 0;
+        if (!candidate_met_in_double(args, i, hit)) args->valid[i] = 0;
     }
 }
 
@@ -237,18 +243,15 @@ void gather_triangles(const RTCFilterFunctionNArguments* args) {
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
         args->valid[i] = 0;
-        const unsigned id = RTCRayN_id(args->ray, args->N, i);
-        if (!context->is_query(id)) continue;
-        const unsigned inst = RTCHitN_instID(args->hit, args->N, i, 0);
-        const bool instanced = inst != RTC_INVALID_GEOMETRY_ID;
-        const Ray ray =
-            instanced ? to_object_space(*(*geometry->instance_transforms)[inst], context->rays[id]) : context->rays[id];
-        const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+        if (!context->is_query(RTCRayN_id(args->ray, args->N, i))) continue;
         ShapeHit hit;
-        if (!hit_triangle_in_double(*geometry->mesh, prim, ray, geometry->as_povray, instanced, hit)) continue;
-        const uint32_t object =
-            instanced ? gathered.scene->instances[(*gathered.mesh_of_geometry)[inst]].object : geometry->mesh->object;
-        gathered.add({hit.t, object, inst, RTCHitN_geomID(args->hit, args->N, i), prim});
+        if (!candidate_met_in_double(args, i, hit)) continue;
+        const unsigned inst = RTCHitN_instID(args->hit, args->N, i, 0);
+        const uint32_t object = inst != RTC_INVALID_GEOMETRY_ID
+                                    ? gathered.scene->instances[(*gathered.mesh_of_geometry)[inst]].object
+                                    : geometry->mesh->object;
+        gathered.add(
+            {hit.t, object, inst, RTCHitN_geomID(args->hit, args->N, i), RTCHitN_primID(args->hit, args->N, i)});
     }
 }
 
