@@ -130,8 +130,9 @@ TEST_P(RenderPerSamples, ACropWindowIsTheWholeRendersPixels) {
         ASSERT_EQ(part.height, window.y_end - window.y_begin);
         EXPECT_TRUE(same_pixels(part, crop_image(whole.image, window)))
             << "window from " << window.x_begin << "," << window.y_begin;
-        if (window.x_end <= render_tile_size)
+        if (window.x_end <= render_tile_size) {
             EXPECT_EQ(cropped.rays.camera, uint64_t(render_tile_size) * 23 * samples * samples);
+        }
     }
     // crop_image itself: the window's rows, each from its first column.
     const Image corner = crop_image(whole.image, {40, 41, 22, 23});
