@@ -12,6 +12,7 @@
 //   sphere CX CY CZ R KM
 //   mesh FILE.obj KM M00 M01 M02 M03 M10 ... M23   (object to world, 3x4 rows; smooth normals)
 #include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
@@ -23,6 +24,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -30,25 +32,13 @@ namespace {
 
 struct Vec {
     float x = 0, y = 0, z = 0;
+    friend Vec operator+(Vec a, Vec b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+    friend Vec operator-(Vec a, Vec b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+    friend Vec operator*(Vec a, float s) { return {a.x * s, a.y * s, a.z * s}; }
+    friend float dot(Vec a, Vec b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+    friend Vec cross(Vec a, Vec b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+    friend Vec normalize(Vec a) { return a * (1.0f / std::sqrt(dot(a, a))); }
 };
-Vec operator+(Vec a, Vec b) {
-    return {a.x + b.x, a.y + b.y, a.z + b.z};
-}
-Vec operator-(Vec a, Vec b) {
-    return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-Vec operator*(Vec a, float s) {
-    return {a.x * s, a.y * s, a.z * s};
-}
-float dot(Vec a, Vec b) {
-    return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-Vec cross(Vec a, Vec b) {
-    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-Vec normalize(Vec a) {
-    return a * (1.0f / std::sqrt(dot(a, a)));
-}
 
 /// What a hit needs for its secondary rays: the normal and the mirror coefficient km.
 struct Shape {

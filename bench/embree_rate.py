@@ -138,16 +138,20 @@ def main():
         for _ in range(args.runs):  # interleaved: both see the same machine
             w.append(whitted_run(ours))
             e.append(embree_run(theirs))
-        w_rate, e_rate = statistics.median(r[0] for r in w), statistics.median(r[0] for r in e)
-        rows.append((name, statistics.median(r[1] for r in w), w_rate, statistics.median(r[1] for r in e), e_rate,
-                     w[0][2], e[0][2], e[0][3]))
-    print(f"\n{args.threads} thread(s), median of {args.runs} interleaved runs; Whitted: render stage (--stats), "
-          "Embree: tracing only")
-    print(f"{'scene':<10} {'Whitted s':>9} {'M rays/s':>8} {'Embree s':>8} {'M rays/s':>8} {'ratio':>6}  "
+        ratios = [a[0] / b[0] for a, b in zip(w, e)]  # pair by pair: the machine's drift cancels
+        rows.append((name, [r[0] for r in w], [r[0] for r in e], ratios, w[0][2], e[0][2], e[0][3]))
+    print(f"\n{args.threads} thread(s), {args.runs} interleaved runs: median (min-max); Whitted: render stage "
+          "(--stats), Embree: tracing only; ratio: Whitted's rate / Embree's, run by run")
+    print(f"{'scene':<10} {'Whitted M rays/s':>17} {'Embree M rays/s':>17} {'ratio':>17}  "
           "rays Whitted / Embree, M (camera, shadow, reflected)")
-    for name, w_s, w_rate, e_s, e_rate, w_counts, e_counts, _ in rows:
+
+    def spread(values, scale=1.0, digits=1):
+        return (f"{scale * statistics.median(values):.{digits}f} ({scale * min(values):.{digits}f}-"
+                f"{scale * max(values):.{digits}f})")
+
+    for name, w_rates, e_rates, ratios, w_counts, e_counts, _ in rows:
         kinds = ", ".join(f"{a:.2f}/{b:.3f} ({100 * (a - b) / b:+.1f}%)" for a, b in zip(w_counts, e_counts))
-        print(f"{name:<10} {w_s:9.3f} {w_rate:8.1f} {e_s:8.3f} {e_rate:8.1f} {100 * w_rate / e_rate:5.0f}%  {kinds}")
+        print(f"{name:<10} {spread(w_rates):>17} {spread(e_rates):>17} {spread(ratios, 100, 0) + ' %':>17}  {kinds}")
     for name, *_, first in rows:
         print(f"{name}: {first}")
     return 0
