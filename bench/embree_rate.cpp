@@ -423,7 +423,14 @@ int main(int argc, char** argv) {
     // WHITTED_EMBREE_ISA as Embree's isa= when set.
     std::string config = "verbose=0,threads=" + std::to_string(threads);
     const char* isa = std::getenv("WHITTED_EMBREE_ISA");
-    if (isa && *isa) config += std::string(",isa=") + isa;
+    if (isa && *isa) {
+        const std::string names[] = {"sse2", "sse4.2", "avx", "avx2", "avx512"};  // Whitted's list
+        if (std::find(std::begin(names), std::end(names), isa) == std::end(names)) {
+            std::fprintf(stderr, "WHITTED_EMBREE_ISA=%s: not one of sse2, sse4.2, avx, avx2, avx512\n", isa);
+            return 2;
+        }
+        config += std::string(",isa=") + isa;
+    }
     tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, size_t(threads));
     RTCDevice device = rtcNewDevice(config.c_str());
     if (!device) {
@@ -453,9 +460,9 @@ int main(int argc, char** argv) {
                            : width == 8 ? render<8>(scene, rtc, counts)
                                         : render<4>(scene, rtc, counts);
     const uint64_t total = counts.camera + counts.shadow + counts.reflected;
-    std::printf("embree: %zu triangles, %zu spheres (%s), quality %s, %d-wide calls, %d thread(s)\n", scene.triangles,
-                scene.spheres, scene.user_spheres ? "user geometry" : "sphere points", low ? "low" : "medium", width,
-                threads);
+    const char* spheres = !scene.spheres ? "" : scene.user_spheres ? " (user geometry)" : " (sphere points)";
+    std::printf("embree: %zu triangles, %zu spheres%s, quality %s, %d-wide calls, %d thread(s)\n", scene.triangles,
+                scene.spheres, spheres, low ? "low" : "medium", width, threads);
     std::printf("rays: camera %llu shadow %llu reflected %llu total %llu\n", (unsigned long long)counts.camera.load(),
                 (unsigned long long)counts.shadow.load(), (unsigned long long)counts.reflected.load(),
                 (unsigned long long)total);
