@@ -108,6 +108,22 @@ Vec read_vec(std::istream& in) {
     return v;
 }
 
+/// Attaches a triangle geometry to `rtc` and its shape to `scene` under its geomID.
+void add_triangles(RTCDevice device, RTCScene rtc, Scene& scene, const std::vector<Vec>& positions,
+                   const std::vector<uint32_t>& corners, Shape shape) {
+    RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    std::copy(positions.begin(), positions.end(),
+              static_cast<Vec*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                        sizeof(Vec), positions.size())));
+    std::copy(corners.begin(), corners.end(),
+              static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                             3 * sizeof(uint32_t), corners.size() / 3)));
+    rtcCommitGeometry(geometry);
+    scene.shapes.resize(rtcAttachGeometry(rtc, geometry) + 1);
+    scene.shapes.back() = std::move(shape);
+    rtcReleaseGeometry(geometry);
+}
+
 /// The OBJ mesh's triangles (v, vn, f with v//n corners, as bench/generate.py writes them),
 /// placed by the 3x4 matrix m; normals by its cofactor matrix (the inverse transpose, scaled).
 void add_mesh(RTCDevice device, RTCScene rtc, Scene& scene, const std::string& path, float km, const float* m) {
@@ -142,19 +158,8 @@ void add_mesh(RTCDevice device, RTCScene rtc, Scene& scene, const std::string& p
             }
         }
     }
-    RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                          3 * sizeof(float), positions.size()));
-    for (size_t i = 0; i < positions.size(); ++i)
-        v[3 * i] = positions[i].x, v[3 * i + 1] = positions[i].y, v[3 * i + 2] = positions[i].z;
-    auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                               3 * sizeof(uint32_t), corners.size() / 3));
-    std::copy(corners.begin(), corners.end(), idx);
     scene.triangles += corners.size() / 3;
-    rtcCommitGeometry(geometry);
-    scene.shapes.resize(rtcAttachGeometry(rtc, geometry) + 1);
-    scene.shapes.back() = std::move(shape);
-    rtcReleaseGeometry(geometry);
+    add_triangles(device, rtc, scene, positions, corners, std::move(shape));
 }
 
 /// Reads SCENE.rays into `scene` and Embree's geometry into `rtc`.
@@ -186,18 +191,7 @@ void read_scene(const char* path, RTCDevice device, RTCScene rtc, Scene& scene) 
             shape.plane_normal = n;
             const Vec a = normalize(cross(n, std::fabs(n.x) < 0.9f ? Vec{1, 0, 0} : Vec{0, 1, 0})) * 1e5f;
             const Vec b = cross(n, a);
-            RTCGeometry quad = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-            auto* v = static_cast<Vec*>(
-                rtcSetNewGeometryBuffer(quad, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(Vec), 4));
-            v[0] = p - a - b, v[1] = p + a - b, v[2] = p + a + b, v[3] = p - a + b;
-            auto* idx = static_cast<uint32_t*>(
-                rtcSetNewGeometryBuffer(quad, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), 2));
-            const uint32_t corners[6] = {0, 1, 2, 0, 2, 3};
-            std::copy(corners, corners + 6, idx);
-            rtcCommitGeometry(quad);
-            scene.shapes.resize(rtcAttachGeometry(rtc, quad) + 1);
-            scene.shapes.back() = shape;
-            rtcReleaseGeometry(quad);
+            add_triangles(device, rtc, scene, {p - a - b, p + a - b, p + a + b, p - a + b}, {0, 1, 2, 0, 2, 3}, shape);
         } else if (item == "sphere") {
             const Vec c = read_vec(in);
             float r, km;
