@@ -98,7 +98,11 @@ Accelerator::Impl::Impl(const Scene& s, int threads, const std::string& instruct
         for (const TriangleMesh& mesh : prototype.meshes)
             most_triangles = std::max(most_triangles, mesh.triangle_count());
     corner_indices = MappedArray<uint32_t>(3 * most_triangles, 0);
-    for (size_t i = 0; i < 3 * most_triangles; ++i) corner_indices.data()[i] = uint32_t(i);
+    // Each triangle's own three corners (widen_triangles writes them in order), on every core.
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, 3 * most_triangles, 3 * 16384),
+                      [indices = corner_indices.data()](const tbb::blocked_range<size_t>& range) {
+                          for (size_t i = range.begin(); i != range.end(); ++i) indices[i] = uint32_t(i);
+                      });
     for (const TriangleMesh& mesh : scene.meshes) world_povray.emplace_back(mesh, scene.intersection);
     for (const Prototype& prototype : scene.prototypes) {
         prototype_povray.emplace_back();

@@ -483,7 +483,7 @@ public:
     };
 
     ObjReader(const std::string& path, const Lines& lines, size_t positions_before, size_t normals_before,
-              size_t faces_before, Output output, MeshData* materials_into)
+              size_t faces_before, size_t faces_held, Output output, MeshData* materials_into)
         : m_path(path),
           m_lines(lines),
           m_positions_before(positions_before),
@@ -491,8 +491,8 @@ public:
           m_faces_before(faces_before),
           m_out(output),
           m_materials_into(materials_into) {
-        position_index.reserve(3 * lines.faces);  // triangles; polygons grow it once
-        face_material.reserve(lines.faces);
+        position_index.reserve(3 * faces_held);  // triangles; polygons grow it once
+        face_material.reserve(faces_held);
     }
 
     void read() {
@@ -918,9 +918,9 @@ constexpr uint64_t max_ear_clipping_tests_per_file = 400'000'000;
 /// not convex) its n − 2 triangles are replaced by triangulate_polygon's, in place, while the
 /// file's budget of ear clipping lasts (granted in file order). The polygons are independent, so
 /// the cores share them; the result does not depend on how.
-void triangulate_polygons(const std::string& path, const std::vector<float>& positions,
-                          const std::vector<Polygon>& polygons, std::vector<uint32_t>& indices,
-                          std::vector<uint32_t>& normal_index, std::vector<std::string>& warnings) {
+void triangulate_polygons(const std::string& path, const FloatArray& positions, const std::vector<Polygon>& polygons,
+                          std::vector<uint32_t>& indices, std::vector<uint32_t>& normal_index,
+                          std::vector<std::string>& warnings) {
     if (polygons.empty()) return;
     // The fan (0, j, j+1) for j = 1 … n−2 names corner 0, corner 1, then one more each.
     const auto fan_corners = [&](const Polygon& polygon, const std::vector<uint32_t>& index,
@@ -1044,15 +1044,18 @@ std::optional<ObjContents> read_obj(const std::string& path, std::string_view te
 
     ObjContents contents;
     MeshData& mesh = contents.mesh;
-    mesh.positions = std::vector<float>(3 * positions);
-    std::vector<float> all_normals(3 * normals);
+    mesh.positions = FloatArray(3 * positions);  // each run writes its own (not zeroed here)
+    FloatArray all_normals(3 * normals);
     std::vector<std::unique_ptr<ObjReader>> readers;
     size_t positions_before = 0, normals_before = 0, faces_before = 0;
     for (const Lines& run : runs) {
+        // The first run's arrays become the mesh's, the others' are appended to them: room for
+        // every face (a triangle each; polygons grow them) is reserved there, untouched till read.
+        const size_t faces_held = readers.empty() ? faces : run.faces;
         const ObjReader::Output output{mesh.positions.data() + 3 * positions_before,
                                        all_normals.data() + 3 * normals_before, run.positions, run.normals};
-        readers.push_back(std::make_unique<ObjReader>(path, run, positions_before, normals_before, faces_before, output,
-                                                      parallel ? nullptr : &mesh));
+        readers.push_back(std::make_unique<ObjReader>(path, run, positions_before, normals_before, faces_before,
+                                                      faces_held, output, parallel ? nullptr : &mesh));
         positions_before += run.positions, normals_before += run.normals, faces_before += run.faces;
     }
     if (!parallel) {
@@ -1088,13 +1091,18 @@ std::optional<ObjContents> read_obj(const std::string& path, std::string_view te
     // Join the runs' faces in file order.
     std::vector<uint32_t> normal_index;
     std::vector<Polygon> polygons;
+    mesh.indices = std::move(readers[0]->position_index);
+    mesh.triangle_material = std::move(readers[0]->face_material);
+    polygons = std::move(readers[0]->polygons);
     if (readers.size() == 1) {
-        mesh.indices = std::move(readers[0]->position_index);
-        mesh.triangle_material = std::move(readers[0]->face_material);
         normal_index = std::move(readers[0]->normal_index);
-        polygons = std::move(readers[0]->polygons);
     } else {
-        for (const auto& reader : readers) {
+        if (every_corner_has_normal && !normals_follow_positions) {
+            const auto& first = readers[0]->normals_follow_positions ? mesh.indices : readers[0]->normal_index;
+            normal_index.assign(first.begin(), first.end());
+        }
+        for (size_t k = 1; k < readers.size(); ++k) {
+            const auto& reader = readers[k];
             const size_t triangles_before = mesh.triangle_material.size();
             for (Polygon polygon : reader->polygons) {
                 polygon.first_triangle += triangles_before;
@@ -1121,7 +1129,7 @@ std::optional<ObjContents> read_obj(const std::string& path, std::string_view te
     }
     // One vertex per distinct (position, normal) pair, numbered in order of first use, so that
     // normals index like positions. Each position keeps a short chain of the vertices made from it.
-    const std::vector<float> file_positions = std::move(mesh.positions);
+    const FloatArray file_positions = std::move(mesh.positions);
     mesh.positions.clear();
     constexpr uint32_t none = std::numeric_limits<uint32_t>::max();
     std::vector<uint32_t> first_vertex(positions, none), next_vertex, vertex_normal;

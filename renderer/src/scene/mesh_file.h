@@ -5,16 +5,44 @@
 #include "scene/description.h"
 
 #include <cstdint>
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace whitted {
 
+/// std::allocator, except that a vector's `resize(n)` or `vector(n)` leaves new numbers
+/// unwritten: the OBJ reader sizes its arrays from a first count and writes every element from
+/// the thread that reads that run of lines, so the pages are first touched there, on every core,
+/// not zeroed first on one (tens of megabytes of page faults for a million-triangle mesh).
+template <class T>
+struct UninitializedAllocator : std::allocator<T> {
+    template <class U>
+    struct rebind {
+        using other = UninitializedAllocator<U>;
+    };
+    UninitializedAllocator() = default;
+    template <class U>
+    UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}  // NOLINT: as std::allocator's
+    template <class U>
+    void construct(U* p) noexcept {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+};
+
+/// Numbers a reader writes one by one into an array sized beforehand (UninitializedAllocator).
+using FloatArray = std::vector<float, UninitializedAllocator<float>>;
+
 /// A triangle mesh as read from a Wavefront OBJ file (and its MTL), in the file's own space.
 /// Vertices are unique (position, normal) pairs so that per-vertex normals index like positions.
 struct MeshData {
-    std::vector<float> positions;                ///< 3 per vertex
-    std::vector<float> normals;                  ///< 3 per vertex, or empty
+    FloatArray positions;                        ///< 3 per vertex
+    FloatArray normals;                          ///< 3 per vertex, or empty
     std::vector<uint32_t> indices;               ///< 3 per triangle
     std::vector<int32_t> triangle_material;      ///< index into materials per triangle, −1 = none
     std::vector<MaterialDescription> materials;  ///< from the MTL: Ka→ka, Kd→kd, Ks→ks, Ns→p, illum 3→km=Ks

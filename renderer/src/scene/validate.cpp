@@ -8,6 +8,10 @@
 #include "scene/scene.h"
 #include "scene/text_checks.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
 #include <algorithm>
 #include <cmath>
 #include <exception>
@@ -481,10 +485,14 @@ private:
             },
             shape.file.where);
         if (!data.normals.empty()) {
-            mesh.normals.reserve(3 * n);
-            for (size_t i = 0; i < n; ++i)
-                push_normal(mesh, to_world.apply_normal(
-                                      {data.normals[3 * i], data.normals[3 * i + 1], data.normals[3 * i + 2]}));
+            mesh.normals.resize(3 * n);
+            tbb::parallel_for(
+                tbb::blocked_range<size_t>(0, n, vertices_per_task), [&](const tbb::blocked_range<size_t>& range) {
+                    for (size_t i = range.begin(); i != range.end(); ++i)
+                        set_normal(&mesh.normals[3 * i],
+                                   to_world.apply_normal(
+                                       {data.normals[3 * i], data.normals[3 * i + 1], data.normals[3 * i + 2]}));
+                });
         }
         mesh.indices = std::move(data.indices);
         mesh.object = add_id(object);
@@ -509,31 +517,60 @@ private:
     /// same to a float's rounding of its own size (docs/validation.md, "Far from the origin"), as
     /// a sphere's or a box's are. A world coordinate beyond float range is refused, naming the
     /// vertex: Embree's BVH needs finite float bounds.
+    /// A mesh of a million vertices is transformed on every core; the bounds are joined in
+    /// vertex order (min and max pick the same of equal values however the runs are cut), and
+    /// the vertex named in an error is the first beyond range, as when read one by one.
     template <class WorldPoint>
     void set_positions(TriangleMesh& mesh, size_t count, const WorldPoint& world_point, const SourceLocation& where) {
         constexpr double inf = std::numeric_limits<double>::infinity();
         constexpr double float_max = std::numeric_limits<float>::max();
-        Vec3 lo(inf), hi(-inf);
-        for (size_t i = 0; i < count; ++i) {
-            const Vec3 p = world_point(i);
-            if (!(std::fabs(p.x) <= float_max && std::fabs(p.y) <= float_max && std::fabs(p.z) <= float_max))
-                fail(where, "vertex " + std::to_string(i) +
-                                " is beyond float range (about 3.4e38) once transformed to world space");
-            lo = min(lo, p), hi = max(hi, p);
-        }
-        mesh.origin = mesh_origin(lo, hi);
-        mesh.positions.clear();
-        mesh.positions.reserve(4 * count);
-        for (size_t i = 0; i < count; ++i) {
-            const Vec3 p = world_point(i) - mesh.origin;
-            mesh.positions.insert(mesh.positions.end(), {float(p.x), float(p.y), float(p.z), 0.0f});
-        }
+        struct Bounds {
+            Vec3 lo, hi;
+            size_t first_beyond;  ///< the first vertex beyond float range, or count
+        };
+        const auto take = [&](const tbb::blocked_range<size_t>& range, Bounds b) {
+            for (size_t i = range.begin(); i != range.end() && b.first_beyond == count; ++i) {
+                const Vec3 p = world_point(i);
+                if (!(std::fabs(p.x) <= float_max && std::fabs(p.y) <= float_max && std::fabs(p.z) <= float_max))
+                    b.first_beyond = i;
+                else
+                    b.lo = min(b.lo, p), b.hi = max(b.hi, p);
+            }
+            return b;
+        };
+        const Bounds none{Vec3(inf), Vec3(-inf), count};
+        const tbb::blocked_range<size_t> all(0, count, vertices_per_task);
+        const Bounds bounds = count <= vertices_per_task
+                                  ? take(all, none)  // the usual triangle or small mesh: no tasks
+                                  : tbb::parallel_reduce(all, none, take, [count](const Bounds& a, const Bounds& b) {
+                                        if (a.first_beyond != count) return a;  // a holds the earlier vertices
+                                        return Bounds{min(a.lo, b.lo), max(a.hi, b.hi), b.first_beyond};
+                                    });
+        if (bounds.first_beyond != count)
+            fail(where, "vertex " + std::to_string(bounds.first_beyond) +
+                            " is beyond float range (about 3.4e38) once transformed to world space");
+        mesh.origin = mesh_origin(bounds.lo, bounds.hi);
+        mesh.positions.assign(4 * count, 0.0f);
+        const auto store = [&](const tbb::blocked_range<size_t>& range) {
+            for (size_t i = range.begin(); i != range.end(); ++i) {
+                const Vec3 p = world_point(i) - mesh.origin;
+                float* out = &mesh.positions[4 * i];
+                out[0] = float(p.x), out[1] = float(p.y), out[2] = float(p.z);
+            }
+        };
+        count <= vertices_per_task ? store(all) : tbb::parallel_for(all, store);
     }
-    static void push_normal(TriangleMesh& mesh, const Vec3& n) {
+    /// Vertices per task of the loops above: a mesh of a few thousand stays on one thread.
+    static constexpr size_t vertices_per_task = 16384;
+    static void set_normal(float* out, const Vec3& n) {
         // A zero normal from the file (rare) stays zero; shading then falls back to the face normal.
         const double len = length(n);
         const Vec3 unit = len > 0 ? n / len : Vec3();
-        mesh.normals.insert(mesh.normals.end(), {float(unit.x), float(unit.y), float(unit.z)});
+        out[0] = float(unit.x), out[1] = float(unit.y), out[2] = float(unit.z);
+    }
+    static void push_normal(TriangleMesh& mesh, const Vec3& n) {
+        mesh.normals.resize(mesh.normals.size() + 3);
+        set_normal(&mesh.normals[mesh.normals.size() - 3], n);
     }
 
     static void check_step(const TransformStep& step) {
