@@ -200,16 +200,16 @@ struct NoObserver {
     void local(int, int, const Color&, const Color&, const Color&) {}
     void mirror(int, int, const Ray&, const Color&) {}
     void transmitted(int, int, const Ray&, const Color&) {}
-    NoObserver for_lane(int) const { return {}; }
+    NoObserver for_lanes(const int*, int, int*) const { return {}; }
 };
 /// PathObserver behind the same interface, with `watching` for what only it needs computed.
-/// A refracted ray's path is traced as a packet of one lane of its own: `lane`, when set, is
-/// the lane of the packet that path belongs to.
+/// Refracted paths are traced as packets of their own: `lanes`, when set, holds for each of
+/// their lanes the lane of the camera packet that path belongs to.
 struct Watching {
     static constexpr bool watching = true;
     PathObserver& to;
-    int lane = -1;
-    int at(int i) const { return lane >= 0 ? lane : i; }
+    const int* lanes = nullptr;
+    int at(int i) const { return lanes ? lanes[i] : i; }
     void miss(int i, int level, const Ray& r, const Color& w, const Color& seen) { to.miss(at(i), level, r, w, seen); }
     void hit(int i, int level, const Ray& r, const SurfaceHit& h, const Vec3& n) { to.hit(at(i), level, r, h, n); }
     void ambient(int i, int level, const Color& a) { to.ambient(at(i), level, a); }
@@ -217,7 +217,12 @@ struct Watching {
     void local(int i, int level, const Color& w, const Color& l, const Color& a) { to.local(at(i), level, w, l, a); }
     void mirror(int i, int level, const Ray& r, const Color& w) { to.mirror(at(i), level, r, w); }
     void transmitted(int i, int level, const Ray& r, const Color& w) { to.transmitted(at(i), level, r, w); }
-    Watching for_lane(int i) const { return {to, at(i)}; }
+    /// The observer of a packet whose lane j continues lane parent[j] of this one; `room`
+    /// (count entries) holds the map.
+    Watching for_lanes(const int* parent, int count, int* room) const {
+        for (int j = 0; j < count; ++j) room[j] = at(parent[j]);
+        return {to, room};
+    }
 };
 }  // namespace
 
@@ -412,6 +417,13 @@ void LectureShading::trace_paths(const Ray* first_rays, const Color* first_weigh
                 observer.ambient(i, level, ambient_term(m_scene.materials[hits[i].material], m_scene.ambient));
         }
         see_lights<Convention>(rays.data(), hits.data(), normal.data(), active, count, lights, counts, level, observer);
+        // This level's refracted rays, lane by lane: lane j's path continues lane parent[j]'s.
+        PacketArray<Ray, packet_size> refracted_rays;
+        PacketArray<Color, packet_size> refracted_weights;
+        std::array<Interiors, packet_size> refracted_interiors;
+        PacketArray<Color, packet_size> refracted_radiance;
+        int parent[packet_size];
+        int refracted_count = 0;
         for (int i = 0; i < count; ++i) {
             if (!active[i]) continue;
             const Material& material = m_scene.materials[hits[i].material];
@@ -427,11 +439,11 @@ void LectureShading::trace_paths(const Ray* first_rays, const Color* first_weigh
             Color mirror_weight = reflected.mirror;
             bool refracted = false;
             Ray refracted_ray;
-            Interiors refracted_interiors;
+            Interiors& refracted_inside = refracted_interiors[refracted_count];
             if (m_transmits && !is_zero(material.kt) && level + 1 < m_scene.max_depth) {
-                refracted_interiors = interiors[i];
+                refracted_inside = interiors[i];
                 Vec3 direction;
-                if (refract(rays[i], hits[i], normal[i], refracted_interiors, direction)) {
+                if (refract(rays[i], hits[i], normal[i], refracted_inside, direction)) {
                     refracted = true;
                     refracted_ray = {hits[i].point, direction, m_spans.leaving(hits[i].point), m_spans.t_max()};
                 } else {
@@ -454,10 +466,21 @@ void LectureShading::trace_paths(const Ray* first_rays, const Color* first_weigh
             if (refracted && worth_tracing(refracted_weight, m_scene.min_weight)) {
                 observer.transmitted(i, level, refracted_ray, refracted_weight);
                 ++counts.reflected;
-                Observer lane = observer.for_lane(i);
-                trace_paths<Convention>(&refracted_ray, &refracted_weight, &refracted_interiors, 1, level + 1,
-                                        &radiance[i], counts, lane);
+                refracted_rays[refracted_count] = refracted_ray;
+                refracted_weights[refracted_count] = refracted_weight;
+                // The path goes on adding to the pixel's sum so far, term by term.
+                refracted_radiance[refracted_count] = radiance[i];
+                parent[refracted_count++] = i;
             }
+        }
+        // Each lane's refracted path adds its terms after that lane's local terms and before
+        // its mirror path's next segment, as the recursion kt·L(t) + km·L(r) orders them.
+        if (refracted_count > 0) {
+            int lanes_room[packet_size];
+            Observer lanes = observer.for_lanes(parent, refracted_count, lanes_room);
+            trace_paths<Convention>(refracted_rays.data(), refracted_weights.data(), refracted_interiors.data(),
+                                    refracted_count, level + 1, refracted_radiance.data(), counts, lanes);
+            for (int j = 0; j < refracted_count; ++j) radiance[parent[j]] = refracted_radiance[j];
         }
     }
 }

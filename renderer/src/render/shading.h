@@ -106,8 +106,10 @@ struct Reflectance {
 ///   light, then their mirror rays. r is traced while the path has surface hits left. The
 ///   refracted ray t (Whitted 1980) bends by Snell's law; where it cannot leave (total internal
 ///   reflection) the light comes back along r with weight 1 in place of both km·L(r) and
-///   kt·L(t); each refracted ray starts a path of its own, traced at once, depth first. A
-///   shadow ray crossing transmitting surfaces brings I times the product of their kt.
+///   kt·L(t); the refracted rays leaving one level's hits start paths of their own, traced
+///   together as a packet before the mirror rays go on, so that each pixel's terms are still
+///   summed in the order of the depth-first recursion. A shadow ray crossing transmitting
+///   surfaces brings I times the product of their kt.
 class LectureShading {
 public:
     LectureShading(const Scene& scene, const Accelerator& accelerator)
