@@ -295,6 +295,54 @@ TEST(Accelerator, GeometricNormalBesideTheShadingNormal) {
     EXPECT_DOUBLE_EQ(hit.normal.z, 1.0);
 }
 
+// A long slanted cylinder and a long cone are cut into parts along their axes for Embree (each
+// with its own box); every ray still gets exactly the whole shape's double test: the same t and
+// normal, whichever part's box it crosses, at the parts' joins too. Shadow rays likewise.
+TEST(Accelerator, ALongConeCutIntoPartsGivesTheWholeConesHit) {
+    const Scene scene = test::scene_from(test::join_lines({
+        "camera: {eye: [0, 0, 8], look_at: [0, 0, 0]}",
+        "image: {width: 8, height: 8}",
+        "objects:",
+        "  - {type: cylinder, base: [-3, -2, -0.5], cap: [3, 2.5, 0.4], radius: 0.2, material: {kd: 0.5}}",
+        "  - {type: cone, base: [-2, 2, 1], base_radius: 0.3, cap: [2.5, -1.5, 0], cap_radius: 0.05,",
+        "     material: {kd: 0.5}}",
+    }));
+    ASSERT_EQ(scene.cones.size(), 2u);
+    const Accelerator accelerator(scene, 1);
+    std::mt19937_64 random(38);
+    std::uniform_real_distribution<double> across(-3.5, 3.5), jitter(-0.05, 0.05);
+    int hits = 0;
+    for (int k = 0; k < 20000; ++k) {
+        // Half the rays aimed at a point of a cylinder's axis, so that many meet it.
+        Vec3 target{across(random), across(random), jitter(random)};
+        if (k % 2) {
+            const Cone& cone = scene.cones[k % 4 == 1 ? 0 : 1];
+            const double s = (across(random) + 3.5) / 7 * cone.height;
+            target = cone.base + cone.axis * s + Vec3{jitter(random), jitter(random), jitter(random)} * 4.0;
+        }
+        const Vec3 origin{across(random), across(random), 8};
+        const Ray ray{origin, normalize(target - origin), 1e-4, 1e7};
+        double nearest = ray.t_max;
+        Vec3 normal;
+        bool expected = false;
+        for (const Cone& cone : scene.cones) {
+            ShapeHit hit;
+            if (intersect_cone(cone, ray, ray.t_min, nearest, hit))
+                nearest = hit.t, normal = normalize(hit.normal), expected = true;
+        }
+        SurfaceHit found;
+        ASSERT_EQ(accelerator.intersect(ray, found), expected) << "ray " << k;
+        EXPECT_EQ(accelerator.occluded(ray), expected) << "ray " << k;
+        if (!expected) continue;
+        ++hits;
+        EXPECT_EQ(found.t, nearest) << "ray " << k;
+        EXPECT_EQ(found.normal.x, normal.x) << "ray " << k;
+        EXPECT_EQ(found.normal.y, normal.y) << "ray " << k;
+        EXPECT_EQ(found.normal.z, normal.z) << "ray " << k;
+    }
+    EXPECT_GT(hits, 5000);
+}
+
 // An instance is its prototype under the transform, hit in double: a unit triangle in z = 0
 // placed by scale [2, 3, -1] (mirrored in z), then translate [10, 0, -4]. Closed form: the
 // world triangle is (10, 0, -4), (12, 0, -4), (10, 3, -4); a ray down -z from (10.5, 0.5, 5)

@@ -176,7 +176,7 @@ namespace {
 /// roots count where 0 ≤ s ≤ h. The roots are taken in the form that loses no digits to
 /// cancellation (q = −(b + sign(b)·√disc), t = q/a and c/q).
 bool cone_hit(const Cone& cone, const Vec3& origin, const Vec3& direction, double t_min, double t_max, double& t,
-              Vec3& normal) {
+              Vec3& normal, double& along) {
     const Vec3& w = cone.axis;
     const Vec3 from_base = origin - cone.base;
     const double o_s = dot(from_base, w), d_s = dot(direction, w);
@@ -191,7 +191,7 @@ bool cone_hit(const Cone& cone, const Vec3& origin, const Vec3& direction, doubl
         if (!(root > t_min && root < t_max) || (found && root >= t)) return;
         const double s = o_s + root * d_s;
         if (!(s >= 0 && s <= cone.height)) return;
-        t = root, found = true;
+        t = root, along = s, found = true;
         // The gradient of |p⊥| − r(s), times r(s) = |p⊥| on the surface: no division.
         const Vec3 across = o_across + d_across * root;
         normal = across - w * (k * (cone.base_radius + k * s));
@@ -214,7 +214,7 @@ bool cone_hit(const Cone& cone, const Vec3& origin, const Vec3& direction, doubl
             if (!(root > t_min && root < t_max) || (found && root >= t)) return;
             const Vec3 across = o_across + d_across * root;
             if (!(dot(across, across) <= radius * radius)) return;
-            t = root, found = true;
+            t = root, along = s, found = true;
             normal = w * sign;
         };
         consider_cap(0, cone.base_radius, -1);
@@ -226,17 +226,19 @@ bool cone_hit(const Cone& cone, const Vec3& origin, const Vec3& direction, doubl
 }  // namespace
 
 bool intersect_cone(const Cone& cone, const Ray& world_ray, double t_min, double t_max, ShapeHit& hit) {
-    double t;
+    double t, along;
     Vec3 normal;
     if (!cone.object_to_world) {
-        if (!cone_hit(cone, world_ray.origin, world_ray.direction, t_min, t_max, t, normal)) return false;
+        if (!cone_hit(cone, world_ray.origin, world_ray.direction, t_min, t_max, t, normal, along)) return false;
         hit.t = t;
+        hit.u = along;
         hit.normal = normal;
         return true;
     }
     const Ray ray = to_object_space(*cone.object_to_world, world_ray);
-    if (!cone_hit(cone, ray.origin, ray.direction, t_min, t_max, t, normal)) return false;
+    if (!cone_hit(cone, ray.origin, ray.direction, t_min, t_max, t, normal, along)) return false;
     hit.t = t;
+    hit.u = along;
     hit.normal = cone.object_to_world->apply_normal(normal);
     return true;
 }
@@ -269,13 +271,25 @@ void world_bounds(const Box& box, Vec3& lo, Vec3& hi) {
 }
 
 void world_bounds(const Cone& cone, Vec3& lo, Vec3& hi) {
+    world_bounds(cone, 0.0, cone.height, lo, hi);
+}
+
+void world_bounds(const Cone& cone, double s_begin, double s_end, Vec3& lo, Vec3& hi) {
     // Each end is a disc across the axis: along a coordinate axis e it reaches r·√(1 − (w·e)²).
     const Vec3& w = cone.axis;
     const Vec3 reach{std::sqrt(std::max(0.0, 1 - w.x * w.x)), std::sqrt(std::max(0.0, 1 - w.y * w.y)),
                      std::sqrt(std::max(0.0, 1 - w.z * w.z))};
-    const Vec3 cap = cone.base + w * cone.height;
-    lo = min(cone.base - reach * cone.base_radius, cap - reach * cone.cap_radius);
-    hi = max(cone.base + reach * cone.base_radius, cap + reach * cone.cap_radius);
+    // The whole cone's ends exactly as given; a part's ends on the line between them.
+    const auto radius_at = [&](double s) {
+        if (s == 0) return cone.base_radius;
+        if (s == cone.height) return cone.cap_radius;
+        return cone.base_radius + (cone.cap_radius - cone.base_radius) * (s / cone.height);
+    };
+    const Vec3 begin = s_begin == 0 ? cone.base : cone.base + w * s_begin;
+    const Vec3 end = cone.base + w * s_end;
+    const double r_begin = radius_at(s_begin), r_end = radius_at(s_end);
+    lo = min(begin - reach * r_begin, end - reach * r_end);
+    hi = max(begin + reach * r_begin, end + reach * r_end);
     if (cone.object_to_world) world_bounds(*cone.object_to_world, Vec3(lo), Vec3(hi), lo, hi);
 }
 

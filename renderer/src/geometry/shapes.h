@@ -11,8 +11,9 @@ namespace whitted {
 
 struct ShapeHit {
     double t = 0;
-    Vec3 normal;   ///< outward geometric normal, world space, not necessarily unit
-    double u = 0;  ///< triangles: barycentric weight of vertex 1
+    Vec3 normal;  ///< outward geometric normal, world space, not necessarily unit
+    double u =
+        0;  ///< triangles: barycentric weight of vertex 1; cones: the hit's distance along the axis from the base
     double v = 0;  ///< triangles: barycentric weight of vertex 2
     /// Boxes: the face is not the one the ray crosses at `t` but a steeper one within 1e-6,
     /// chosen by POV-Ray's edge rule (intersect_box); the accelerator lets another box's plain
@@ -30,7 +31,8 @@ bool intersect_sphere(const Sphere& sphere, const Ray& ray, double t_min, double
 bool intersect_box(const Box& box, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
 /// The side as a quadric in the cone's own frame (the axis and the plane across it), then the
 /// caps as discs unless the cone is open; the nearest hit. Exact in double: no tolerance but
-/// t_min. The side's normal is the gradient of |p⊥| − r(s), scaled by r(s).
+/// t_min. The side's normal is the gradient of |p⊥| − r(s), scaled by r(s); hit.u is s, the
+/// hit's distance along the axis from the base in the cone's own space (0 and height on the caps).
 bool intersect_cone(const Cone& cone, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
 bool intersect_plane(const Plane& plane, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
 /// Möller–Trumbore; the normal is (v1 − v0) × (v2 − v0). `edge_margin` widens the triangle by
@@ -59,6 +61,9 @@ uint32_t triangle_material(const Instance& instance, const TriangleMesh& mesh, u
 void world_bounds(const Sphere& sphere, Vec3& lo, Vec3& hi);
 void world_bounds(const Box& box, Vec3& lo, Vec3& hi);
 void world_bounds(const Cone& cone, Vec3& lo, Vec3& hi);
+/// World-space bounds of the part of a cone between s_begin and s_end along its axis
+/// (0 ≤ s_begin ≤ s_end ≤ height): the frustum's two end discs.
+void world_bounds(const Cone& cone, double s_begin, double s_end, Vec3& lo, Vec3& hi);
 /// World-space bounds of the axis-aligned box [lo, hi] of an object's space under `to_world`
 /// (the extremes of its eight corners).
 void world_bounds(const Transform& to_world, const Vec3& lo, const Vec3& hi, Vec3& out_lo, Vec3& out_hi);

@@ -108,14 +108,22 @@ void analytic_bounds(const RTCBoundsFunctionArguments* args) {
     Vec3 lo, hi;
     if (geometry->kind == ShapeKind::spheres)
         world_bounds(geometry->scene->spheres[args->primID], lo, hi);
-    else if (geometry->kind == ShapeKind::cones)
-        world_bounds(geometry->scene->cones[args->primID], lo, hi);
-    else
+    else if (geometry->kind != ShapeKind::cones)
         world_bounds(geometry->scene->boxes[args->primID], lo, hi);
+    // Widen by a relative margin so that float rounding of the bounds never clips a hit: for a
+    // part of a cone, the whole cone's margin.
+    Vec3 pad;
+    if (geometry->kind == ShapeKind::cones) {
+        const ConeSegment& segment = geometry->segments[args->primID];
+        const Cone& cone = geometry->scene->cones[segment.cone];
+        world_bounds(cone, lo, hi);
+        pad = (hi - lo) * 1e-6 + Vec3(1e-6);
+        world_bounds(cone, segment.s_begin, segment.s_end, lo, hi);
+    } else {
+        pad = (hi - lo) * 1e-6 + Vec3(1e-6);
+    }
     lo -= geometry->offset;
     hi -= geometry->offset;
-    // Widen by a relative margin so that float rounding of the bounds never clips a hit.
-    const Vec3 pad = (hi - lo) * 1e-6 + Vec3(1e-6);
     lo -= pad;
     hi += pad;
     args->bounds_o->lower_x = std::nextafter(float(lo.x), -INFINITY);
@@ -132,6 +140,9 @@ void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
     if (context->gathering) return;  // nearest_triangle's query asks for triangles only
     RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, args->N);
     RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, args->N);
+    // A part of a cone (ConeSegment) reports the cone itself, and only the hit that is its own.
+    const ConeSegment* segment = geometry->kind == ShapeKind::cones ? &geometry->segments[args->primID] : nullptr;
+    const unsigned prim = segment ? segment->cone : args->primID;
     for (unsigned i = 0; i < args->N; ++i) {
         if (!args->valid[i]) continue;
         const unsigned id = RTCRayN_id(rays, args->N, i);
@@ -140,8 +151,9 @@ void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
         const double limit = std::min(context->best_t[id], double(RTCRayN_tfar(rays, args->N, i)));
         // Up to and including the limit, to see a hit at exactly the t of the one held.
         ShapeHit hit;
-        if (!intersect_analytic(*geometry, args->primID, ray, next_up(limit), hit)) continue;
-        const auto [material, object] = material_and_object(*geometry->scene, geometry->kind, args->primID);
+        if (!intersect_analytic(*geometry, prim, ray, next_up(limit), hit)) continue;
+        if (segment && !(hit.u >= segment->owns_from && hit.u < segment->owns_to)) continue;
+        const auto [material, object] = material_and_object(*geometry->scene, geometry->kind, prim);
         if (hit.t == limit) {
             // At a triangle's (float) distance, or at the ray's end: the candidate does not win.
             if (limit != context->best_t[id] || !(limit < ray.t_max)) continue;
@@ -173,7 +185,7 @@ void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
         // Round the float distance up so Embree keeps visiting boxes that may hold a closer hit.
         RTCRayN_tfar(rays, args->N, i) = next_up(float(hit.t));
         RTCHitN_geomID(hits, args->N, i) = args->geomID;
-        RTCHitN_primID(hits, args->N, i) = args->primID;
+        RTCHitN_primID(hits, args->N, i) = prim;
         RTCHitN_instID(hits, args->N, i, 0) = RTC_INVALID_GEOMETRY_ID;
         RTCHitN_u(hits, args->N, i) = 0;
         RTCHitN_v(hits, args->N, i) = 0;
@@ -186,13 +198,15 @@ void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
 void analytic_occluded(const RTCOccludedFunctionNArguments* args) {
     const auto* geometry = static_cast<const AnalyticGeometry*>(args->geometryUserPtr);
     const auto* context = reinterpret_cast<const QueryContext*>(args->context);
+    // Any hit on the cone blocks, whichever part's box the ray is in.
+    const unsigned prim = geometry->kind == ShapeKind::cones ? geometry->segments[args->primID].cone : args->primID;
     for (unsigned i = 0; i < args->N; ++i) {
         if (!args->valid[i]) continue;
         const unsigned id = RTCRayN_id(args->ray, args->N, i);
         if (!context->is_query(id)) continue;
         const Ray& ray = context->rays[id];
         ShapeHit hit;
-        if (intersect_analytic(*geometry, args->primID, ray, ray.t_max, hit))
+        if (intersect_analytic(*geometry, prim, ray, ray.t_max, hit))
             RTCRayN_tfar(args->ray, args->N, i) = -INFINITY;  // Embree's mark for "occluded"
     }
 }

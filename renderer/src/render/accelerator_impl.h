@@ -112,10 +112,24 @@ struct TriangleCandidates {
     void add(const TriangleCandidate& candidate);
 };
 
+/// A part of a cone along its axis, one primitive of Embree's (Impl::add_cone_segments): a long
+/// slanted cylinder's axis-aligned box is mostly empty, its parts' boxes far less so. Each part
+/// tests the whole cone, the same double test, and keeps only the hit whose distance along the
+/// axis (ShapeHit::u) is its own: so every hit belongs to exactly one part, as it did to the
+/// one cone.
+struct ConeSegment {
+    uint32_t cone;
+    double s_begin, s_end;  ///< the stretch along the axis that the part's box holds
+    /// The hits it keeps: owns_from ≤ s < owns_to, which is s_begin ≤ s < s_end but from −∞ for
+    /// the first part and to +∞ for the last.
+    double owns_from, owns_to;
+};
+
 struct AnalyticGeometry {
     ShapeKind kind;
     const Scene* scene;
-    Vec3 offset;  ///< Embree's coordinates are world minus this (Impl::choose_frame)
+    Vec3 offset;                        ///< Embree's coordinates are world minus this (Impl::choose_frame)
+    std::vector<ConeSegment> segments;  ///< cones: Embree's primitives, parts of Scene::cones
 };
 
 /// What triangle_filter needs of a mesh: its triangles, how they are decided
@@ -216,9 +230,9 @@ struct Accelerator::Impl {
     /// How POV-Ray holds each mesh of the world, and of each prototype.
     std::vector<MeshAsPovray> world_povray;
     std::vector<std::vector<MeshAsPovray>> prototype_povray;
-    accel::AnalyticGeometry spheres{accel::ShapeKind::spheres, nullptr, {}};
-    accel::AnalyticGeometry boxes{accel::ShapeKind::boxes, nullptr, {}};
-    accel::AnalyticGeometry cones{accel::ShapeKind::cones, nullptr, {}};
+    accel::AnalyticGeometry spheres{accel::ShapeKind::spheres, nullptr, {}, {}};
+    accel::AnalyticGeometry boxes{accel::ShapeKind::boxes, nullptr, {}, {}};
+    accel::AnalyticGeometry cones{accel::ShapeKind::cones, nullptr, {}, {}};
     RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;  ///< of the scene and its meshes (build_quality)
     int lane_width = 1;                                  ///< rays per Embree packet call (native_lane_width)
     /// Embree works in float in a frame of its own (choose_frame). Rays, vertices and bounds
@@ -244,6 +258,7 @@ struct Accelerator::Impl {
                       const std::vector<const Transform*>* transforms = nullptr);
     void add_instances();
     void add_analytic(accel::AnalyticGeometry& user, size_t count);
+    void add_cone_segments();
     void record(unsigned id, accel::ShapeKind kind, uint32_t mesh);
 
     // The frame and the reach (accelerator_frame.cpp).
