@@ -12,8 +12,9 @@ namespace whitted {
 struct ShapeHit {
     double t = 0;
     Vec3 normal;  ///< outward geometric normal, world space, not necessarily unit
-    double u =
-        0;  ///< triangles: barycentric weight of vertex 1; cones: the hit's distance along the axis from the base
+    /// Triangles: the barycentric weight of vertex 1; cones: the hit's distance along the axis
+    /// from the base.
+    double u = 0;
     double v = 0;  ///< triangles: barycentric weight of vertex 2
     /// Boxes: the face is not the one the ray crosses at `t` but a steeper one within 1e-6,
     /// chosen by POV-Ray's edge rule (intersect_box); the accelerator lets another box's plain
