@@ -83,8 +83,8 @@ def main():
         # POV-Ray's decisions at edges, grazes and ties (--intersection povray). The timed render
         # decides hits exactly and may differ from POV-Ray at such pixels; its comparison is shown.
         checked_img = out / f"{name}.whitted-povray-rule.exr"
-        subprocess.run(our_cmd[:4] + [str(checked_img), "--threads", str(args.threads), "--intersection", "povray"],
-                       check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        subprocess.run([args.whitted, "render", str(scene), "-o", str(checked_img), "--threads", str(args.threads),
+                        "--intersection", "povray"], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         compare = [args.whitted, "compare", "--clip"]
         agree = subprocess.run(compare + [str(checked_img), str(reference_img)], stdout=subprocess.PIPE, text=True)
         exact = subprocess.run(compare + [str(ours_img), str(reference_img)], stdout=subprocess.PIPE, text=True)

@@ -264,10 +264,7 @@ void Accelerator::Impl::find_tie_neighbours() {
     std::vector<uint32_t> top;  // the top-level geomIDs of triangles
     for (uint32_t id = 0; id < kinds.size(); ++id) {
         WorldBox& b = box[id];
-        const auto take = [&b](const Vec3& p) {
-            b.lo = Vec3(std::min(b.lo.x, p.x), std::min(b.lo.y, p.y), std::min(b.lo.z, p.z));
-            b.hi = Vec3(std::max(b.hi.x, p.x), std::max(b.hi.y, p.y), std::max(b.hi.z, p.z));
-        };
+        const auto take = [&b](const Vec3& p) { b.lo = min(b.lo, p), b.hi = max(b.hi, p); };
         if (kinds[id] == ShapeKind::triangles) {
             const TriangleMesh& mesh = scene.meshes[mesh_of_geometry[id]];
             for (size_t v = 0; v < mesh.vertex_count(); ++v) take(mesh.vertex(v));
@@ -289,9 +286,7 @@ void Accelerator::Impl::find_tie_neighbours() {
     }
     // Sweep along the axis the boxes spread furthest on, so that few pairs are looked at.
     Vec3 lo(inf), hi(-inf);
-    for (uint32_t id : top)
-        lo = Vec3(std::min(lo.x, box[id].lo.x), std::min(lo.y, box[id].lo.y), std::min(lo.z, box[id].lo.z)),
-        hi = Vec3(std::max(hi.x, box[id].hi.x), std::max(hi.y, box[id].hi.y), std::max(hi.z, box[id].hi.z));
+    for (uint32_t id : top) lo = min(lo, box[id].lo), hi = max(hi, box[id].hi);
     const Vec3 spread = hi - lo;
     const int axis = spread.x >= spread.y && spread.x >= spread.z ? 0 : spread.y >= spread.z ? 1 : 2;
     const auto along = [axis](const Vec3& p) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; };

@@ -486,13 +486,10 @@ private:
             shape.file.where);
         if (!data.normals.empty()) {
             mesh.normals.resize(3 * n);
-            tbb::parallel_for(
-                tbb::blocked_range<size_t>(0, n, vertices_per_task), [&](const tbb::blocked_range<size_t>& range) {
-                    for (size_t i = range.begin(); i != range.end(); ++i)
-                        set_normal(&mesh.normals[3 * i],
-                                   to_world.apply_normal(
-                                       {data.normals[3 * i], data.normals[3 * i + 1], data.normals[3 * i + 2]}));
-                });
+            for_each_vertex(n, [&](size_t i) {
+                set_normal(&mesh.normals[3 * i], to_world.apply_normal({data.normals[3 * i], data.normals[3 * i + 1],
+                                                                        data.normals[3 * i + 2]}));
+            });
         }
         mesh.indices = std::move(data.indices);
         mesh.object = add_id(object);
@@ -551,17 +548,24 @@ private:
                             " is beyond float range (about 3.4e38) once transformed to world space");
         mesh.origin = mesh_origin(bounds.lo, bounds.hi);
         mesh.positions.assign(4 * count, 0.0f);
-        const auto store = [&](const tbb::blocked_range<size_t>& range) {
-            for (size_t i = range.begin(); i != range.end(); ++i) {
-                const Vec3 p = world_point(i) - mesh.origin;
-                float* out = &mesh.positions[4 * i];
-                out[0] = float(p.x), out[1] = float(p.y), out[2] = float(p.z);
-            }
-        };
-        count <= vertices_per_task ? store(all) : tbb::parallel_for(all, store);
+        for_each_vertex(count, [&](size_t i) {
+            const Vec3 p = world_point(i) - mesh.origin;
+            float* out = &mesh.positions[4 * i];
+            out[0] = float(p.x), out[1] = float(p.y), out[2] = float(p.z);
+        });
     }
-    /// Vertices per task of the loops above: a mesh of a few thousand stays on one thread.
+    /// Vertices per task of the loops over a mesh's vertices: a mesh of a few thousand stays on
+    /// one thread.
     static constexpr size_t vertices_per_task = 16384;
+    /// body(i) for each vertex i < count, on every core when there are more than one task's worth.
+    template <class Body>
+    static void for_each_vertex(size_t count, const Body& body) {
+        const auto run = [&body](const tbb::blocked_range<size_t>& range) {
+            for (size_t i = range.begin(); i != range.end(); ++i) body(i);
+        };
+        const tbb::blocked_range<size_t> all(0, count, vertices_per_task);
+        count <= vertices_per_task ? run(all) : tbb::parallel_for(all, run);
+    }
     static void set_normal(float* out, const Vec3& n) {
         // A zero normal from the file (rare) stays zero; shading then falls back to the face normal.
         const double len = length(n);
