@@ -1,0 +1,145 @@
+// SPDX-License-Identifier: MIT
+// The program's operator new (renderer/app/large_blocks.cpp), linked into this test as into
+// `whitted`: a block of 1 MiB up to an eighth of the machine's memory has its pages mapped
+// before it is written; the standard's contract for failure kept.
+
+#include "large_blocks.h"
+
+#include <gtest/gtest.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <new>
+#include <vector>
+
+namespace {
+
+namespace blocks = whitted::large_blocks;
+
+/// How many of the pages wholly inside [block, block + size) are mapped (mincore).
+size_t mapped_pages(const void* block, size_t size, size_t& pages) {
+    const uintptr_t page = uintptr_t(sysconf(_SC_PAGESIZE));
+    const uintptr_t first = (uintptr_t(block) + page - 1) / page * page;
+    const uintptr_t end = (uintptr_t(block) + size) / page * page;
+    pages = end > first ? (end - first) / page : 0;
+    std::vector<unsigned char> resident(pages);
+    if (pages == 0 || mincore(reinterpret_cast<void*>(first), end - first, resident.data()) != 0) return 0;
+    size_t mapped = 0;
+    for (const unsigned char r : resident) mapped += r & 1;
+    return mapped;
+}
+
+/// Whether this kernel maps pages on request (MADV_POPULATE_WRITE, Linux 5.14).
+bool kernel_populates() {
+    const size_t page = size_t(sysconf(_SC_PAGESIZE));
+    void* mapping = mmap(nullptr, page, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (mapping == MAP_FAILED) return false;
+    const bool populates = madvise(mapping, page, 23 /* MADV_POPULATE_WRITE */) == 0;
+    munmap(mapping, page);
+    return populates;
+}
+
+TEST(LargeBlocks, TheRangeIsOneMebibyteToAnEighthOfMemory) {
+    EXPECT_EQ(blocks::populated_from(), size_t(1) << 20);
+    const size_t memory = size_t(sysconf(_SC_PHYS_PAGES)) * size_t(sysconf(_SC_PAGESIZE));
+    EXPECT_EQ(blocks::populated_up_to(), memory / 8);
+}
+
+TEST(LargeBlocks, BlocksInTheRangeAreMappedBeforeTheyAreWritten) {
+    if (!blocks::replaces_operator_new()) GTEST_SKIP() << "the sanitizer's operator new is kept";
+    if (!kernel_populates()) GTEST_SKIP() << "this kernel predates MADV_POPULATE_WRITE";
+    // Sizes at both ends of the range, odd sizes, and the image of the anchors (1280×960 RGB).
+    for (const size_t bytes : {blocks::populated_from(), blocks::populated_from() + 1, size_t(15) << 20,
+                               size_t(1280) * 960 * 3 * sizeof(float) + 12}) {
+        const std::unique_ptr<char[]> block(new char[bytes]);  // not written: no first touch
+        size_t pages = 0;
+        const size_t mapped = mapped_pages(block.get(), bytes, pages);
+        ASSERT_GT(pages, 0u);
+        EXPECT_EQ(mapped, pages) << bytes << " bytes";
+    }
+    std::vector<float> image;
+    image.reserve(size_t(1280) * 960 * 3);
+    size_t pages = 0;
+    const size_t mapped = mapped_pages(image.data(), image.capacity() * sizeof(float), pages);
+    EXPECT_EQ(mapped, pages);
+}
+
+TEST(LargeBlocks, BlocksBeyondTheRangeAreLeftToFault) {
+    if (!blocks::replaces_operator_new()) GTEST_SKIP() << "the sanitizer's operator new is kept";
+    // Only addresses: the pages are not mapped unless something writes them.
+    const size_t bytes = blocks::populated_up_to() + (size_t(1) << 20);
+    const std::unique_ptr<char[]> block(new (std::nothrow) char[bytes]);
+    if (!block) GTEST_SKIP() << "no " << bytes << " bytes of addresses to give";
+    size_t pages = 0;
+    const size_t mapped = mapped_pages(block.get(), bytes, pages);
+    EXPECT_GT(pages, 0u);
+    EXPECT_LT(mapped, pages / 100);
+}
+
+TEST(LargeBlocks, PopulateMapsOnlyThePagesInsideTheBlock) {
+    if (!kernel_populates()) GTEST_SKIP() << "this kernel predates MADV_POPULATE_WRITE";
+    // A private mapping of 4 MiB, populated from its second page's middle to its last page's
+    // middle: only the pages wholly inside are mapped.
+    const size_t page = size_t(sysconf(_SC_PAGESIZE)), size = size_t(4) << 20;
+    void* mapping = mmap(nullptr, size, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    ASSERT_NE(mapping, MAP_FAILED);
+    char* base = static_cast<char*>(mapping);
+    blocks::populate(base + page + page / 2, size - 2 * page);
+    std::vector<unsigned char> resident(size / page);
+    ASSERT_EQ(mincore(mapping, size, resident.data()), 0);
+    const size_t last = size / page - 1;
+    EXPECT_EQ(resident[0] & 1, 0);
+    EXPECT_EQ(resident[1] & 1, 0);  // the block starts inside it
+    for (size_t k = 2; k < last; ++k) EXPECT_EQ(resident[k] & 1, 1) << k;
+    EXPECT_EQ(resident[last] & 1, 0);  // the block ends inside it
+    munmap(mapping, size);
+}
+
+TEST(LargeBlocks, SizesOutsideTheRangeAreNotPopulated) {
+    const size_t page = size_t(sysconf(_SC_PAGESIZE)), size = size_t(4) << 20;
+    void* mapping = mmap(nullptr, size, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    ASSERT_NE(mapping, MAP_FAILED);
+    blocks::populate(mapping, blocks::populated_from() - 1);
+    blocks::populate(nullptr, size);
+    std::vector<unsigned char> resident(size / page);
+    ASSERT_EQ(mincore(mapping, size, resident.data()), 0);
+    for (const unsigned char r : resident) EXPECT_EQ(r & 1, 0);
+    munmap(mapping, size);
+}
+
+TEST(LargeBlocks, ImpossibleSizesThrowOrGiveNull) {
+    volatile size_t impossible = std::numeric_limits<size_t>::max() - 4096;
+    EXPECT_THROW((void)::operator new(impossible), std::bad_alloc);
+    EXPECT_EQ(::operator new(impossible, std::nothrow), nullptr);
+    volatile size_t too_many = std::numeric_limits<size_t>::max() / 2;
+    EXPECT_EQ(::operator new[](too_many, std::nothrow), nullptr);
+}
+
+int calls = 0;
+void give_up() {
+    ++calls;
+    std::set_new_handler(nullptr);  // then the allocation throws
+}
+
+TEST(LargeBlocks, TheNewHandlerIsAskedBeforeThrowing) {
+    calls = 0;
+    std::set_new_handler(give_up);
+    volatile size_t impossible = std::numeric_limits<size_t>::max() - 4096;
+    EXPECT_THROW((void)::operator new(impossible), std::bad_alloc);
+    EXPECT_EQ(calls, 1);
+    std::set_new_handler(nullptr);
+}
+
+TEST(LargeBlocks, ZeroBytesGiveDistinctBlocks) {
+    void* a = ::operator new(0);
+    void* b = ::operator new(0);
+    EXPECT_NE(a, nullptr);
+    EXPECT_NE(a, b);
+    ::operator delete(a);
+    ::operator delete(b);
+}
+
+}  // namespace
