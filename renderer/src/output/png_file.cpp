@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <stdexcept>
 
 namespace whitted {
@@ -117,6 +118,10 @@ bool run(PngJob& job) {
 /// and joined, the way pigz does it; their Adler-32 sums combine into the stream's. zlib's
 /// level 6 took 0.13 s for a 1280x960 8-bit image and level 1 on one core 0.022 s (8 bits) or
 /// about 0.1 s (16 bits); see docs/performance.md.
+///
+/// Its buffers are not zeroed first: every byte of a band's filtered rows is written, and of its
+/// deflate output only what deflate wrote is kept (a zeroed output buffer, deflate's bound, was
+/// mostly never written, and each of its fresh pages is a page fault, docs/performance.md).
 std::vector<unsigned char> compress_rows(const unsigned char* rows, size_t row_bytes, int height, int bits) {
     // 16-bit rows have noisy low bytes where deflate's string matching rarely pays: run-length
     // matching only was twice as fast on the spheres anchor (0.037 s against 0.072 s on one
@@ -125,15 +130,20 @@ std::vector<unsigned char> compress_rows(const unsigned char* rows, size_t row_b
     constexpr int band = 64;
     const int bands = (height + band - 1) / band;
     const auto band_count = static_cast<size_t>(bands);
-    std::vector<std::vector<unsigned char>> parts(band_count);
+    struct Part {
+        std::unique_ptr<unsigned char[]> bytes;
+        size_t size = 0;
+    };
+    std::vector<Part> parts(band_count);
     std::vector<uLong> sums(band_count);
     std::vector<size_t> lengths(band_count);
     std::atomic<bool> failed{false};
     tbb::parallel_for(0, bands, [&](int b) {
         const int first = b * band, count = std::min(band, height - first);
-        std::vector<unsigned char> filtered(size_t(count) * (row_bytes + 1));
+        const size_t filtered_size = size_t(count) * (row_bytes + 1);
+        const auto filtered = std::make_unique_for_overwrite<unsigned char[]>(filtered_size);
         for (int y = first; y < first + count; ++y) {
-            unsigned char* out = filtered.data() + size_t(y - first) * (row_bytes + 1);
+            unsigned char* out = filtered.get() + size_t(y - first) * (row_bytes + 1);
             const unsigned char* row = rows + size_t(y) * row_bytes;
             out[0] = 2;  // PNG filter type 2, "up"
             if (y == 0) {
@@ -143,30 +153,34 @@ std::vector<unsigned char> compress_rows(const unsigned char* rows, size_t row_b
                 for (size_t i = 0; i < row_bytes; ++i) out[1 + i] = static_cast<unsigned char>(row[i] - above[i]);
             }
         }
-        sums[size_t(b)] = adler32(adler32(0, nullptr, 0), filtered.data(), uInt(filtered.size()));
-        lengths[size_t(b)] = filtered.size();
+        sums[size_t(b)] = adler32(adler32(0, nullptr, 0), filtered.get(), uInt(filtered_size));
+        lengths[size_t(b)] = filtered_size;
         z_stream stream{};
         if (deflateInit2(&stream, 1, Z_DEFLATED, -15, 8, strategy) != Z_OK) {
             failed = true;
             return;
         }
-        std::vector<unsigned char>& part = parts[size_t(b)];
-        part.resize(deflateBound(&stream, uLong(filtered.size())) + 16);
-        stream.next_in = filtered.data();
-        stream.avail_in = uInt(filtered.size());
-        stream.next_out = part.data();
-        stream.avail_out = uInt(part.size());
+        Part& part = parts[size_t(b)];
+        const size_t bound = deflateBound(&stream, uLong(filtered_size)) + 16;
+        part.bytes = std::make_unique_for_overwrite<unsigned char[]>(bound);
+        stream.next_in = filtered.get();
+        stream.avail_in = uInt(filtered_size);
+        stream.next_out = part.bytes.get();
+        stream.avail_out = uInt(bound);
         const bool last = b == bands - 1;
         const int status = deflate(&stream, last ? Z_FINISH : Z_SYNC_FLUSH);
         if (status != (last ? Z_STREAM_END : Z_OK) || stream.avail_in != 0) failed = true;
-        part.resize(part.size() - stream.avail_out);
+        part.size = bound - stream.avail_out;
         deflateEnd(&stream);
     });
     if (failed) throw std::runtime_error("zlib could not compress the image");
+    size_t total = 2 + 4;
+    for (const Part& part : parts) total += part.size;
     std::vector<unsigned char> stream = {0x78, 0x01};  // zlib header: deflate, 32K window, fastest
+    stream.reserve(total);
     uLong sum = sums[0];
     for (size_t b = 0; b < parts.size(); ++b) {
-        stream.insert(stream.end(), parts[b].begin(), parts[b].end());
+        stream.insert(stream.end(), parts[b].bytes.get(), parts[b].bytes.get() + parts[b].size);
         if (b > 0) sum = adler32_combine(sum, sums[b], z_off_t(lengths[b]));
     }
     for (const int shift : {24, 16, 8, 0}) stream.push_back(static_cast<unsigned char>(sum >> shift));
@@ -185,7 +199,8 @@ void write_png(const std::string& path, const Image& linear, const DisplayTransf
     const int width = linear.width, height = linear.height;
     const size_t samples_per_row = 3 * size_t(width);
     const size_t row_bytes = samples_per_row * size_t(bits / 8);
-    std::vector<unsigned char> rows(row_bytes * size_t(height));
+    // Not zeroed: the bands write every byte.
+    const auto rows = std::make_unique_for_overwrite<unsigned char[]>(row_bytes * size_t(height));
     // In double, the product and the half are exact, so every value rounds to its nearest code
     // (in float, 0.7f * 255 + 0.5f came out 179, not 178).
     const double scale = bits == 16 ? 65535.0 : 255.0;
@@ -197,7 +212,7 @@ void write_png(const std::string& path, const Image& linear, const DisplayTransf
         std::vector<float> values(linear.rgb.begin() + std::ptrdiff_t(samples_per_row * size_t(first)),
                                   linear.rgb.begin() + std::ptrdiff_t(samples_per_row * size_t(first + count)));
         display.apply(values.data(), size_t(width) * size_t(count));
-        unsigned char* out = rows.data() + row_bytes * size_t(first);
+        unsigned char* out = rows.get() + row_bytes * size_t(first);
         for (size_t i = 0; i < values.size(); ++i) {
             const float v = values[i] > 0 ? std::min(values[i], 1.0f) : 0.0f;  // NaN fails `> 0`
             const auto code = static_cast<uint32_t>(double(v) * scale + 0.5);
@@ -220,7 +235,7 @@ void write_png(const std::string& path, const Image& linear, const DisplayTransf
     }
     std::FILE* file = std::fopen(path.c_str(), "wb");
     if (!file) throw std::runtime_error("cannot open '" + path + "' for writing: " + std::strerror(errno));
-    const std::vector<unsigned char> idat = compress_rows(rows.data(), row_bytes, height, bits);
+    const std::vector<unsigned char> idat = compress_rows(rows.get(), row_bytes, height, bits);
     PngJob job{file, width, height, bits, idat.data(), idat.size(), texts.data(), int(texts.size()), display.encoding(),
                {}};
     errno = 0;
