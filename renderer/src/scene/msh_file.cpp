@@ -6,6 +6,7 @@
 
 #include "scene/text_checks.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <string_view>
@@ -95,6 +96,9 @@ MeshData load_msh_mesh(const std::string& path, const SourceLocation& referenced
     const int64_t triangle_count = read_count(words, "the triangle count (line 2)", limits::max_triangles);
     if (vertex_count < 3) throw InputError({path, 1, 1}, "a mesh needs at least 3 vertices");
     if (triangle_count < 1) throw InputError({path, 2, 1}, "a mesh needs at least one triangle");
+    // The counts reserve no more than the file can hold (a number and a space take two bytes at
+    // least): a header's count is not trusted with memory before the numbers are there.
+    const size_t most_numbers = text.size() / 2 + 1;
     MeshData mesh;
     bool seen_vertices = false, seen_triangles = false, seen_normals = false, seen_texcoords = false;
     for (;;) {
@@ -107,12 +111,12 @@ MeshData load_msh_mesh(const std::string& path, const SourceLocation& referenced
         };
         if (section == "vertices") {
             once(seen_vertices);
-            mesh.positions.reserve(3 * size_t(vertex_count));
+            mesh.positions.reserve(std::min(3 * size_t(vertex_count), most_numbers));
             for (int64_t i = 0; i < 3 * vertex_count; ++i)
                 mesh.positions.push_back(float(read_number(words, "vertex " + std::to_string(i / 3))));
         } else if (section == "triangles") {
             once(seen_triangles);
-            mesh.indices.reserve(3 * size_t(triangle_count));
+            mesh.indices.reserve(std::min(3 * size_t(triangle_count), most_numbers));
             for (int64_t i = 0; i < 3 * triangle_count; ++i) {
                 SourceLocation at;
                 const std::string what = "triangle " + std::to_string(i / 3);
@@ -129,7 +133,7 @@ MeshData load_msh_mesh(const std::string& path, const SourceLocation& referenced
             }
         } else if (section == "normals") {
             once(seen_normals);
-            mesh.normals.reserve(3 * size_t(vertex_count));
+            mesh.normals.reserve(std::min(3 * size_t(vertex_count), most_numbers));
             for (int64_t i = 0; i < 3 * vertex_count; ++i)
                 mesh.normals.push_back(float(read_number(words, "normal " + std::to_string(i / 3))));
         } else if (section == "texcoords") {
