@@ -10,9 +10,11 @@
 // "Design choices and what they cost"). Huge pages would spare more but cost more on hosts that
 // reclaim a guest's free memory in 2 MiB blocks: main() turns them off.
 //
-// Blocks larger than an eighth of the machine's memory are left to fault as they are written: a
-// caller may reserve more than it fills, and mapping it all at once could take memory the
-// machine does not have. madvise is advice here: where the kernel predates
+// Blocks larger than 256 MiB (or an eighth of the machine's memory, if less) are left to fault as
+// they are written: a caller may reserve more than it fills (a buffer sized by a file's header,
+// say, before the file is found short), and mapping it all at once would take memory, and time,
+// the work may never need. The largest blocks of the bench scenes (the image, a mesh's arrays)
+// are tens of megabytes. madvise is advice here: where the kernel predates
 // MADV_POPULATE_WRITE (Linux 5.14) or refuses, the block is ordinary memory.
 //
 // Only the program replaces operator new: the library (libwhitted, the Python module) leaves
@@ -32,6 +34,7 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <new>
@@ -49,7 +52,8 @@ size_t populated_from() {
 size_t populated_up_to() {
     static const size_t limit = [] {
         const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-        return pages > 0 && page > 0 ? size_t(pages) / 8 * size_t(page) : size_t(0);
+        const size_t most = size_t(256) << 20;
+        return pages > 0 && page > 0 ? std::min(most, size_t(pages) / 8 * size_t(page)) : size_t(0);
     }();
     return limit;
 }

@@ -7,7 +7,7 @@
 namespace whitted::large_blocks {
 
 /// Blocks of populated_from() to populated_up_to() bytes have their pages mapped when they are
-/// allocated (1 MiB, and an eighth of the machine's memory).
+/// allocated (1 MiB, and 256 MiB or an eighth of the machine's memory if that is less).
 size_t populated_from();
 size_t populated_up_to();
 /// False under AddressSanitizer or ThreadSanitizer, whose own operator new is kept.
