@@ -69,8 +69,8 @@ bool replaces_operator_new() {
 void populate(void* block, size_t size) {
     if (!block || size < populated_from() || size > populated_up_to()) return;
     const uintptr_t page = uintptr_t(sysconf(_SC_PAGESIZE));
-    // The pages wholly inside the block: the one it starts in may hold malloc's bookkeeping of
-    // a neighbour, and is written at once anyway.
+    // The pages wholly inside the block: the page it starts in holds malloc's header, already
+    // written, and the one it ends in may be another block's.
     const uintptr_t first = (uintptr_t(block) + page - 1) / page * page;
     const uintptr_t end = (uintptr_t(block) + size) / page * page;
     if (end > first) ::madvise(reinterpret_cast<void*>(first), end - first, MADV_POPULATE_WRITE);
