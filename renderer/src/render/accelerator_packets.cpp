@@ -4,6 +4,7 @@
 // a single ray's.
 #include "render/accelerator_impl.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace whitted {
@@ -84,6 +85,16 @@ struct EmbreePacket<16> {
         rtcOccluded16(valid, scene, context, rays);
     }
 };
+
+/// Whether so few of the rays are active that they are cheaper traced one by one: at most half
+/// of Embree's packet width. Measured on the SPD databases (docs/performance.md, "Packets with
+/// few rays"): a packet with half its lanes in use costs about what its rays cost alone, and
+/// tracing every ray alone is a third slower on triangles.
+bool few_lanes(const bool* active, int count, int lane_width) {
+    int in_use = 0;
+    for (int i = 0; i < count; ++i) in_use += active[i];
+    return in_use <= std::max(1, lane_width / 2);
+}
 
 }  // namespace
 
@@ -170,10 +181,12 @@ void Accelerator::Impl::intersect_packet(const Ray* rays, const bool* active, in
     bool from_here[packet_size];
     active = without_rays_from_afar(rays, active, count, from_here,
                                     [&](int i) { found[i] = intersect_from_afar(rays[i], hits[i]); });
-    // One ray (a refracted path) goes through Embree's single-ray traversal: a W-wide packet
-    // with one lane in use walks the same nodes at W lanes' cost.
-    if (count == 1) {
-        if (active[0]) found[0] = intersect(rays[0], hits[0]);
+    // A few rays (a refracted path, the last steps of a shadow walk) go one by one through
+    // Embree's single-ray traversal: a W-wide packet with one lane in use walks the same nodes
+    // at W lanes' cost. The answers are the same either way (decided in double).
+    if (few_lanes(active, count, lane_width)) {
+        for (int i = 0; i < count; ++i)
+            if (active[i]) found[i] = intersect(rays[i], hits[i]);
         embree_error.throw_if_failed("while tracing rays");
         return;
     }
@@ -212,8 +225,9 @@ void Accelerator::Impl::occluded_lanes(QueryContext& context, const Ray* rays, c
 void Accelerator::Impl::occluded_packet(const Ray* rays, const bool* active, int count, bool* blocked) const {
     bool from_here[packet_size];
     active = without_rays_from_afar(rays, active, count, from_here, [&](int i) { blocked[i] = occluded(rays[i]); });
-    if (count == 1) {  // one ray, as in intersect_packet
-        if (active[0]) blocked[0] = occluded(rays[0]);
+    if (few_lanes(active, count, lane_width)) {  // a few rays, as in intersect_packet
+        for (int i = 0; i < count; ++i)
+            if (active[i]) blocked[i] = occluded(rays[i]);
         embree_error.throw_if_failed("while tracing shadow rays");
         return;
     }
