@@ -119,6 +119,8 @@ Accelerator::Impl::Impl(const Scene& s, int threads, const std::string& instruct
     if (!scene.spheres.empty()) add_analytic(spheres, scene.spheres.size());
     if (!scene.boxes.empty()) add_analytic(boxes, scene.boxes.size());
     if (!scene.cones.empty()) add_cone_segments();
+    const bool own_shapes = !scene.spheres.empty() || !scene.boxes.empty() || !scene.cones.empty();
+    single_ray_lanes = std::max(1, own_shapes ? lane_width / 2 : lane_width / 4);
     rtcCommitScene(rtc_scene);
     try {
         embree_error.throw_if_failed("while building the BVH");

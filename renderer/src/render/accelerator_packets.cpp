@@ -4,7 +4,6 @@
 // a single ray's.
 #include "render/accelerator_impl.h"
 
-#include <algorithm>
 #include <cmath>
 
 namespace whitted {
@@ -86,14 +85,12 @@ struct EmbreePacket<16> {
     }
 };
 
-/// Whether so few of the rays are active that they are cheaper traced one by one: at most half
-/// of Embree's packet width. Measured on the SPD databases (docs/performance.md, "Packets with
-/// few rays"): a packet with half its lanes in use costs about what its rays cost alone, and
-/// tracing every ray alone is a third slower on triangles.
-bool few_lanes(const bool* active, int count, int lane_width) {
+/// Whether at most `most` of the rays are active: they are then cheaper traced one by one
+/// (Impl::single_ray_lanes).
+bool few_lanes(const bool* active, int count, int most) {
     int in_use = 0;
     for (int i = 0; i < count; ++i) in_use += active[i];
-    return in_use <= std::max(1, lane_width / 2);
+    return in_use <= most;
 }
 
 }  // namespace
@@ -184,7 +181,7 @@ void Accelerator::Impl::intersect_packet(const Ray* rays, const bool* active, in
     // A few rays (a refracted path, the last steps of a shadow walk) go one by one through
     // Embree's single-ray traversal: a W-wide packet with one lane in use walks the same nodes
     // at W lanes' cost. The answers are the same either way (decided in double).
-    if (few_lanes(active, count, lane_width)) {
+    if (few_lanes(active, count, single_ray_lanes)) {
         for (int i = 0; i < count; ++i)
             if (active[i]) found[i] = intersect(rays[i], hits[i]);
         embree_error.throw_if_failed("while tracing rays");
@@ -225,7 +222,7 @@ void Accelerator::Impl::occluded_lanes(QueryContext& context, const Ray* rays, c
 void Accelerator::Impl::occluded_packet(const Ray* rays, const bool* active, int count, bool* blocked) const {
     bool from_here[packet_size];
     active = without_rays_from_afar(rays, active, count, from_here, [&](int i) { blocked[i] = occluded(rays[i]); });
-    if (few_lanes(active, count, lane_width)) {  // a few rays, as in intersect_packet
+    if (few_lanes(active, count, single_ray_lanes)) {  // a few rays, as in intersect_packet
         for (int i = 0; i < count; ++i)
             if (active[i]) blocked[i] = occluded(rays[i]);
         embree_error.throw_if_failed("while tracing shadow rays");
