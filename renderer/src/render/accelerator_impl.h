@@ -236,8 +236,9 @@ struct Accelerator::Impl {
     RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;  ///< of the scene and its meshes (build_quality)
     int lane_width = 1;                                  ///< rays per Embree packet call (native_lane_width)
     /// A packet with at most this many rays in use traces them one by one (few_lanes): half the
-    /// lane width where the scene has shapes of its own (spheres, boxes, cones: Embree calls
-    /// their test lane by lane in a packet too), a quarter where it has triangles only.
+    /// lane width where the scene has shapes of its own (spheres, boxes, cones: their test, the
+    /// callback Embree calls with a packet, goes through its lanes one by one anyway), a
+    /// quarter where it has triangles only.
     int single_ray_lanes = 1;
     /// Embree works in float in a frame of its own (choose_frame). Rays, vertices and bounds
     /// are shifted in double before they are rounded, so a scene far from the origin keeps
