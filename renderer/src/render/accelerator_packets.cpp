@@ -180,16 +180,14 @@ void Accelerator::Impl::intersect_packet(const Ray* rays, const bool* active, in
                                     [&](int i) { found[i] = intersect_from_afar(rays[i], hits[i]); });
     // A few rays (a refracted path, the last steps of a shadow walk) go one by one through
     // Embree's single-ray traversal: a W-wide packet with one lane in use walks the same nodes
-    // at W lanes' cost. The answers are the same either way (decided in double).
-    if (few_lanes(active, count, single_ray_lanes)) {
-        for (int i = 0; i < count; ++i)
-            if (active[i]) found[i] = intersect(rays[i], hits[i]);
-        embree_error.throw_if_failed("while tracing rays");
-        return;
+    // at W lanes' cost; so do all rays where Embree has no packets (in_native_groups). The
+    // answers are the same either way (decided in double).
+    bool traced = false;
+    if (!few_lanes(active, count, single_ray_lanes)) {
+        QueryContext context(rays, active, count, true);
+        traced = in_native_groups(
+            count, [&]<int W>(int first) { intersect_lanes<W>(context, rays, active, first, count, hits, found); });
     }
-    QueryContext context(rays, active, count, true);
-    const bool traced = in_native_groups(
-        count, [&]<int W>(int first) { intersect_lanes<W>(context, rays, active, first, count, hits, found); });
     if (!traced)
         for (int i = 0; i < count; ++i)
             if (active[i]) found[i] = intersect(rays[i], hits[i]);
@@ -222,22 +220,19 @@ void Accelerator::Impl::occluded_lanes(QueryContext& context, const Ray* rays, c
 void Accelerator::Impl::occluded_packet(const Ray* rays, const bool* active, int count, bool* blocked) const {
     bool from_here[packet_size];
     active = without_rays_from_afar(rays, active, count, from_here, [&](int i) { blocked[i] = occluded(rays[i]); });
-    if (few_lanes(active, count, single_ray_lanes)) {  // a few rays, as in intersect_packet
+    bool traced = false;
+    if (!few_lanes(active, count, single_ray_lanes)) {  // a few rays go one by one, as in intersect_packet
+        // Planes first (no BVH): a ray a plane blocks needs no Embree query.
+        bool query[packet_size];
+        for (int i = 0; i < count; ++i) query[i] = active[i] && !(blocked[i] = occluded_by_plane(rays[i]));
+        QueryContext context(rays, query, count, true);
+        context.embree.filter = shadow_filter();
+        traced = in_native_groups(
+            count, [&]<int W>(int first) { occluded_lanes<W>(context, rays, query, first, count, blocked); });
+    }
+    if (!traced)  // occluded() tests the planes first too
         for (int i = 0; i < count; ++i)
             if (active[i]) blocked[i] = occluded(rays[i]);
-        embree_error.throw_if_failed("while tracing shadow rays");
-        return;
-    }
-    // Planes first (no BVH): a ray a plane blocks needs no Embree query.
-    bool query[packet_size];
-    for (int i = 0; i < count; ++i) query[i] = active[i] && !(blocked[i] = occluded_by_plane(rays[i]));
-    QueryContext context(rays, query, count, true);
-    context.embree.filter = shadow_filter();
-    const bool traced = in_native_groups(
-        count, [&]<int W>(int first) { occluded_lanes<W>(context, rays, query, first, count, blocked); });
-    if (!traced)
-        for (int i = 0; i < count; ++i)
-            if (query[i]) blocked[i] = occluded(rays[i]);
     embree_error.throw_if_failed("while tracing shadow rays");
 }
 
