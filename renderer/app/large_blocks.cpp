@@ -110,12 +110,8 @@ void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
         return nullptr;
     }
 }
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept {
-    try {
-        return allocate_or_throw(size);
-    } catch (...) {
-        return nullptr;
-    }
+void* operator new[](std::size_t size, const std::nothrow_t& nothrow) noexcept {
+    return ::operator new(size, nothrow);
 }
 void operator delete(void* block) noexcept {
     std::free(block);
