@@ -8,7 +8,6 @@ the memory of a tiny render. The program maps the pages of large blocks when it 
 Usage: header_counts.py WHITTED"""
 
 import os
-import resource
 import subprocess
 import sys
 import tempfile
