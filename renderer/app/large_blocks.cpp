@@ -17,6 +17,17 @@
 // are tens of megabytes. madvise is advice here: where the kernel predates
 // MADV_POPULATE_WRITE (Linux 5.14) or refuses, the block is ordinary memory.
 //
+// Smaller blocks: malloc's own defaults let go of memory a render soon asks for again. Above
+// 128 KiB (a threshold glibc then moves as blocks are freed) a block is mapped afresh, and
+// when more than 128 KiB lies free at the top of a heap the heap is cut back; the next block
+// faults its pages in again, each fault a TLB shootdown on every core as well. Writing a PNG,
+// each band of rows goes through OpenColorIO with a 64 KiB scratch buffer of its own: on some
+// images (SPD `tetra -s 5`, 512x512) a thread's heap was cut back and regrown for every band,
+// and the write took 24 ms instead of 7. So keep_freed_memory fixes both thresholds: blocks
+// under populated_from() always come from the heaps, and up to 64 MiB freed at a heap's top
+// is kept. Larger blocks are mapped and given back as before. Measured in docs/performance.md
+// ("Design choices and what they cost").
+//
 // Only the program replaces operator new: the library (libwhitted, the Python module) leaves
 // its host's allocator alone. Memory from here is malloc's and operator delete frees it. Under
 // AddressSanitizer or ThreadSanitizer nothing is replaced: their own operator new checks every
@@ -31,6 +42,7 @@
 #endif
 #endif
 
+#include <malloc.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -74,6 +86,18 @@ void populate(void* block, size_t size) {
     const uintptr_t first = (uintptr_t(block) + page - 1) / page * page;
     const uintptr_t end = (uintptr_t(block) + size) / page * page;
     if (end > first) ::madvise(reinterpret_cast<void*>(first), end - first, MADV_POPULATE_WRITE);
+}
+
+size_t kept_free() {
+    return size_t(64) << 20;
+}
+
+void keep_freed_memory() {
+#ifndef WHITTED_SANITIZED_NEW
+    // Each call also stops glibc moving the other threshold (mallopt(3)): both are set.
+    ::mallopt(M_MMAP_THRESHOLD, int(populated_from()));
+    ::mallopt(M_TRIM_THRESHOLD, int(kept_free()));
+#endif
 }
 
 }  // namespace whitted::large_blocks

@@ -5,6 +5,7 @@
 // report.h.
 
 #include "explain_command.h"
+#include "large_blocks.h"
 #include "live_command.h"
 #include "report.h"
 #include "whitted/whitted.h"
@@ -500,6 +501,8 @@ int main(int argc, char** argv) {
     // first touch costs the host 512 faults: BVH builds ran several times slower, and no scene
     // rendered faster with them (docs/performance.md, "Design choices and what they cost").
     prctl(PR_SET_THP_DISABLE, 1, 0, 0, 0);
+    // Freed blocks under 1 MiB stay in malloc's heaps for the next one (large_blocks.cpp).
+    whitted::large_blocks::keep_freed_memory();
     // Past a file size limit (ulimit -f) a write fails with EFBIG, which every command reports and
     // cleans up after, instead of SIGXFSZ killing the process with a temporary file left.
     std::signal(SIGXFSZ, SIG_IGN);
