@@ -9,6 +9,7 @@
 #include "scene/text_checks.h"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -24,6 +25,21 @@ namespace {
 /// The most corners one `p` or `pp` may have: the OBJ reader's cap on a face, for the same
 /// reason (a polygon is cut into triangles in time that grows faster than its size).
 constexpr int64_t max_polygon_corners = 20000;
+
+/// What a byte is to the tokenizer: part of a token, a blank, the end of a line or the start of
+/// a comment. One table lookup per byte: the large SPD files are hundreds of megabytes.
+enum ByteClass : unsigned char { token_byte = 0, blank_byte = 1, line_end_byte = 2, comment_byte = 3 };
+constexpr std::array<unsigned char, 256> byte_classes = [] {
+    std::array<unsigned char, 256> classes{};
+    for (const unsigned char c : {' ', '\t', '\f', '\v'}) classes[c] = blank_byte;
+    classes['\n'] = classes['\r'] = line_end_byte;
+    classes['#'] = comment_byte;
+    return classes;
+}();
+
+inline ByteClass byte_class(char c) {
+    return ByteClass(byte_classes[static_cast<unsigned char>(c)]);
+}
 
 struct Token {
     std::string_view text;
@@ -83,26 +99,22 @@ private:
         for (;;) {
             if (m_pos >= m_text.size()) return std::nullopt;
             const char c = m_text[m_pos];
-            if (c == '\n' || c == '\r') {
+            const ByteClass kind = byte_class(c);
+            if (kind == token_byte) break;
+            if (kind == blank_byte) {
+                ++m_pos;
+            } else if (kind == line_end_byte) {
                 // CR LF, LF and CR alone each end one line.
                 if (c == '\r' && m_pos + 1 < m_text.size() && m_text[m_pos + 1] == '\n') ++m_pos;
                 ++m_pos;
                 ++m_line;
                 m_line_start = m_pos;
-            } else if (c == ' ' || c == '\t' || c == '\f' || c == '\v') {
-                ++m_pos;
-            } else if (c == '#') {
-                while (m_pos < m_text.size() && m_text[m_pos] != '\n' && m_text[m_pos] != '\r') ++m_pos;
             } else {
-                break;
+                while (m_pos < m_text.size() && m_text[m_pos] != '\n' && m_text[m_pos] != '\r') ++m_pos;
             }
         }
         const size_t start = m_pos;
-        while (m_pos < m_text.size()) {
-            const char c = m_text[m_pos];
-            if (c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v' || c == '#') break;
-            ++m_pos;
-        }
+        while (m_pos < m_text.size() && byte_class(m_text[m_pos]) == token_byte) ++m_pos;
         m_end_line = m_line;
         m_end_column = int(m_pos - m_line_start) + 1;
         return Token{m_text.substr(start, m_pos - start), m_line, int(start - m_line_start) + 1};
@@ -342,8 +354,12 @@ private:
     /// that follow one another with the same fill share one inline mesh (patches another, with
     /// their vertex normals).
     void read_polygon(const Token& code, bool patch) {
-        const std::string what = patch ? "patch" : "polygon";
-        const Located<int64_t> count = whole_number(what + " corner count", 3, max_polygon_corners);
+        // The names for messages are made once: a large file has millions of polygons.
+        static const std::string polygon = "polygon", patch_name = "patch", polygon_count = "polygon corner count",
+                                 patch_count = "patch corner count", polygon_corner = "polygon corner",
+                                 patch_corner = "patch corner", patch_normal = "patch normal";
+        const std::string& what = patch ? patch_name : polygon;
+        const Located<int64_t> count = whole_number(patch ? patch_count : polygon_count, 3, max_polygon_corners);
         const auto n = size_t(count.value);
         // Each corner takes at least "0 0 0 " (or twice that with a normal): a small file cannot
         // claim a huge count and have it reserved.
@@ -352,9 +368,9 @@ private:
         m_corners.clear();
         m_normals.clear();
         for (size_t i = 0; i < n; ++i) {
-            m_corners.push_back(vector(what + " corner").value);
+            m_corners.push_back(vector(patch ? patch_corner : polygon_corner).value);
             if (patch) {
-                const Located<Vec3> normal = vector("patch normal");
+                const Located<Vec3> normal = vector(patch_normal);
                 if (normal.value.x == 0 && normal.value.y == 0 && normal.value.z == 0)
                     throw InputError(normal.where, "patch normal must not be the zero vector");
                 m_normals.push_back(normal.value);
@@ -374,8 +390,9 @@ private:
         if (first + int64_t(n) > int64_t(UINT32_MAX))
             throw InputError(count.where, "more than 2^32 corners in the polygons of one fill");
         // A triangle is its own cut (most polygons of most databases are triangles).
-        const std::vector<uint32_t> triangles =
-            n == 3 ? std::vector<uint32_t>{0, 1, 2} : triangulate_polygon(m_corners);
+        static const std::vector<uint32_t> one_triangle = {0, 1, 2};
+        const std::vector<uint32_t> cut = n == 3 ? std::vector<uint32_t>() : triangulate_polygon(m_corners);
+        const std::vector<uint32_t>& triangles = n == 3 ? one_triangle : cut;
         m_triangles += int64_t(triangles.size() / 3);
         if (m_triangles > limits::max_triangles)
             throw InputError(where(code), "more than " + std::to_string(limits::max_triangles) +
