@@ -34,11 +34,12 @@ api::Expected<void> parse_pixel(const std::string& text, int& x, int& y) {
 
 }  // namespace
 
-int run_explain(const std::string& scene_path, const std::string& pixel, bool json, bool summary, int threads) {
+int run_explain(const std::string& scene_path, const std::string& pixel, const api::SceneOverrides& overrides,
+                bool json, bool summary, int threads) {
     int x = 0, y = 0;
     // Usage first: nothing here reads the scene.
     if (const api::Expected<void> parsed = parse_pixel(pixel, x, y); !parsed) return report(parsed.error());
-    const api::Expected<api::Scene> scene = api::load_scene_file(scene_path, {}, api::SceneUse::render_only);
+    const api::Expected<api::Scene> scene = api::load_scene_file(scene_path, overrides, api::SceneUse::render_only);
     if (!scene) return report(scene.error());
     if (x >= scene->width() || y >= scene->height())
         return report(

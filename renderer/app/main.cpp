@@ -623,6 +623,7 @@ int main(int argc, char** argv) {
     std::string explain_scene, explain_pixel_text;
     bool explain_json = false, explain_summary = false;
     int explain_threads = 0;
+    api::SceneOverrides explain_overrides;  // --intersection
     CLI::App* explain_cmd = app.add_subcommand(
         "explain", "Print every term of one pixel's equation, as the render computes it (docs/layers.md)");
     explain_cmd->add_option("scene", explain_scene, "Scene file")->required()->check(CLI::ExistingFile);
@@ -635,6 +636,11 @@ int main(int argc, char** argv) {
         ->add_flag("--summary", explain_summary,
                    "Print the pixel in a dozen lines: its first hit, each term averaged over the samples, the pixel")
         ->excludes(explain_json_flag);
+    explain_cmd
+        ->add_option("--intersection", explain_overrides.intersection,
+                     "How hits are decided, replacing render.intersection: exact (the default) or povray "
+                     "(POV-Ray 3.7's decisions, as `whitted check` renders)")
+        ->check(CLI::IsMember({"exact", "povray"}));
     explain_cmd->add_option("-t,--threads", explain_threads, "Threads for building the BVH (default: all cores)")
         ->check(CLI::Range(0, 4096));
 
@@ -783,7 +789,8 @@ int main(int argc, char** argv) {
     // its errors, by run_reporting.
     if (*explain_cmd)
         return run_reporting("explaining a pixel of " + explain_scene, [&] {
-            return run_explain(explain_scene, explain_pixel_text, explain_json, explain_summary, explain_threads);
+            return run_explain(explain_scene, explain_pixel_text, explain_overrides, explain_json, explain_summary,
+                               explain_threads);
         });
     if (*render_cmd) {
         const int code = run_reporting("rendering " + render_args.scene, [&] { return run_render(render_args); });

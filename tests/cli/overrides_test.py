@@ -4,7 +4,7 @@
 --intersection replace the scene's settings as if the file said them, --crop renders a window
 whose pixels are the whole render's bit for bit, `-` reads the scene from standard input, and
 every mistake is a usage error (exit 2) before any work, leaving an existing output as it was.
-Also: the nearest-name suggestions, `explain --summary`, and the warning for pixels past the
+Also: the nearest-name suggestions, `explain --summary` and `--intersection`, and the warning for pixels past the
 largest float.
 
 Each expectation is derived from the rule, not from a render of this code: the size from the
@@ -196,6 +196,23 @@ check(exr_match is not None and np.array_equal(
     np.array([float(exr_match.group(k)) for k in (1, 2, 3)], np.float32), read_exr("file.exr")[50, 48]),
     f"explain --summary: the EXR value is not the render's: {exr_match and exr_match.group(0)}")
 run(["explain", base, "--pixel", "48,50", "--summary", "--json"], expect=2)
+
+# --- explain --intersection -----------------------------------------------------------------------
+# As render's: the scene explained as if the file said render.intersection. The same lines,
+# the file's name aside; under POV-Ray's rule the camera ray looks from t = 1e-4 to 1e7
+# (docs/pov-model.md §3), under the exact one from 0.
+povray_file = written("explain_povray.yaml", **{"render.intersection": "povray"})
+by_option = run(["explain", base, "--pixel", "48,50", "--intersection", "povray"]).stdout.decode()
+by_file = run(["explain", povray_file, "--pixel", "48,50"]).stdout.decode()
+by_option = by_option.replace(os.path.basename(base), "SCENE").splitlines()
+by_file = by_file.replace(os.path.basename(povray_file), "SCENE").splitlines()
+check(by_option == by_file and len(by_option) > 5,
+      f"explain --intersection povray is not the explanation of the file that says it: {by_option[:4]} vs {by_file[:4]}")
+check("t in (0.0001, 10000000)" in "\n".join(by_option), f"explain --intersection povray: camera ray {by_option[3:5]}")
+exact = run(["explain", base, "--pixel", "48,50", "--intersection", "exact"]).stdout.decode()
+check("camera ray" in exact and "t in (0, " in exact, f"explain --intersection exact: {exact[:400]}")
+result = run(["explain", base, "--pixel", "48,50", "--intersection", "fast"], expect=2)
+check(b"--intersection" in result.stderr, f"explain --intersection fast: {result.stderr!r}")
 
 # Names reach the terminal escaped, and --json is JSON whatever bytes a name holds (an MTL
 # material name may be Latin-1).
