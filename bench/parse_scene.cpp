@@ -10,12 +10,10 @@
 #include "scene/text_checks.h"
 #include "scene/yaml_tree.h"
 
-#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
-#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
@@ -70,9 +68,7 @@ int main(int argc, char** argv) {
             size_t objects = 0;
             const auto count = [&](const whitted::yaml_tree::Node&, size_t) { ++objects; };
             // The value tree is YAML's (and JSON's); an NFF or course XML file has none.
-            std::string extension = std::filesystem::path(path).extension().string();
-            for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
-            const bool yaml = extension == ".yaml" || extension == ".yml" || extension == ".json";
+            const bool yaml = whitted::scene_format(path, file.text()) == whitted::SceneFormat::yaml;
             for (const auto reader : {whitted::yaml_tree::Reader::fast, whitted::yaml_tree::Reader::libyaml}) {
                 if (parse_only || !yaml) break;
                 const Seconds s = best_of(runs, [&] {
