@@ -12,6 +12,8 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
+#include <vector>
 
 namespace whitted {
 namespace {
@@ -309,6 +311,44 @@ RecordedRays record(const Scene& scene, const Ray& ray) {
 }
 
 }  // namespace
+
+// The objects a refracted ray is inside: every sequence of entering (push_back), leaving the
+// innermost (pop_back) and leaving another (erase) gives the list a plain vector gives, through
+// the change from the entries held in place to the heap and back, and a copy is the same list.
+TEST(Interiors, KeepTheObjectsInOrderAsAPlainListDoes) {
+    std::mt19937 random(20261206);
+    for (int run = 0; run < 200; ++run) {
+        Interiors list;
+        std::vector<Interiors::Entry> model;
+        for (int step = 0; step < 60; ++step) {
+            const auto choice = random() % 3;
+            if (model.empty() || choice == 0) {
+                const Interiors::Entry entry{uint32_t(random() % 1000), 1.0 + double(random() % 100) / 64.0};
+                list.push_back(entry);
+                model.push_back(entry);
+            } else if (choice == 1) {
+                list.pop_back();
+                model.pop_back();
+            } else {
+                const size_t at = random() % model.size();
+                list.erase(list.begin() + at);
+                model.erase(model.begin() + std::ptrdiff_t(at));
+            }
+            const Interiors copy = list;
+            for (const Interiors* seen : {static_cast<const Interiors*>(&list), &copy}) {
+                ASSERT_EQ(size_t(seen->end() - seen->begin()), model.size());
+                ASSERT_EQ(seen->empty(), model.empty());
+                for (size_t i = 0; i < model.size(); ++i) {
+                    ASSERT_EQ(seen->begin()[i].object, model[i].object);
+                    ASSERT_EQ(seen->begin()[i].ior, model[i].ior);
+                }
+                if (!model.empty()) {
+                    ASSERT_EQ(seen->back().object, model.back().object);
+                }
+            }
+        }
+    }
+}
 
 TEST(Refraction, ASlabShiftsARayByTheTextbookAmount) {
     // A slab 0 ≤ y ≤ 1 of index 1.5, met at θ = 50° from its normal: inside the ray runs at θ'

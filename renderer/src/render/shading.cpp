@@ -274,21 +274,21 @@ bool LectureShading::refract(const Ray& ray, const SurfaceHit& hit, const Vec3& 
     const uint32_t object = hit.object;
     const double ior = m_scene.materials[hit.material].ior;
     double eta;
-    const auto inside =
-        std::find_if(interiors.begin(), interiors.end(), [object](const auto& entry) { return entry.first == object; });
+    const Interiors::Entry* const inside = std::find_if(
+        interiors.begin(), interiors.end(), [object](const Interiors::Entry& entry) { return entry.object == object; });
     if (interiors.empty()) {
         eta = 1.0 / ior;
-        interiors.emplace_back(object, ior);
-    } else if (interiors.back().first == object) {
-        const double leaving = interiors.back().second;
+        interiors.push_back({object, ior});
+    } else if (interiors.back().object == object) {
+        const double leaving = interiors.back().ior;
         interiors.pop_back();
-        eta = leaving / (interiors.empty() ? 1.0 : interiors.back().second);
+        eta = leaving / (interiors.empty() ? 1.0 : interiors.back().ior);
     } else if (inside != interiors.end()) {
         interiors.erase(inside);
         eta = 1.0;
     } else {
-        eta = interiors.back().second / ior;
-        interiors.emplace_back(object, ior);
+        eta = interiors.back().ior / ior;
+        interiors.push_back({object, ior});
     }
     // The same medium on both sides: the ray goes on unbent.
     if (std::fabs(eta - 1.0) < 1e-10) {

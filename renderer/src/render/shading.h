@@ -6,6 +6,8 @@
 #include "render/ray_spans.h"
 #include "scene/scene.h"
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -63,8 +65,52 @@ public:
     virtual void transmitted(int lane, int level, const Ray& refracted_ray, const Color& weight) = 0;
 };
 
-/// The transmitting objects a ray is inside, innermost last: (object number, index of refraction).
-using Interiors = std::vector<std::pair<uint32_t, double>>;
+/// The transmitting objects a ray is inside, innermost last. Every refracted ray starts from a
+/// copy of its parent's, so the first few are held in place: a path through glass is seldom
+/// inside more than one or two objects, and a heap block per refracted ray was a tenth of
+/// gears' render (malloc, free and the copies). Deeper nesting (up to max_depth) goes on the heap.
+class Interiors {
+public:
+    struct Entry {
+        uint32_t object;  ///< the object's number (SurfaceHit::object)
+        double ior;       ///< its index of refraction
+    };
+    bool empty() const { return m_count == 0; }
+    const Entry* begin() const { return data(); }
+    const Entry* end() const { return data() + m_count; }
+    const Entry& back() const { return data()[m_count - 1]; }
+    void push_back(const Entry& entry) {
+        if (m_count < in_place) {
+            m_in_place[m_count++] = entry;
+            return;
+        }
+        if (m_count == in_place) m_beyond.assign(m_in_place, m_in_place + in_place);
+        m_beyond.push_back(entry);
+        ++m_count;
+    }
+    void pop_back() { erase(end() - 1); }
+    /// Removes the entry at `at` (one of this list's), keeping the others' order.
+    void erase(const Entry* at) {
+        const auto index = size_t(at - begin());
+        if (m_count > in_place) {
+            m_beyond.erase(m_beyond.begin() + std::ptrdiff_t(index));
+            if (--m_count == in_place) {
+                std::copy(m_beyond.begin(), m_beyond.end(), m_in_place);
+                m_beyond.clear();
+            }
+            return;
+        }
+        std::copy(m_in_place + index + 1, m_in_place + m_count, m_in_place + index);
+        --m_count;
+    }
+
+private:
+    static constexpr size_t in_place = 4;
+    const Entry* data() const { return m_count > in_place ? m_beyond.data() : m_in_place; }
+    size_t m_count = 0;
+    Entry m_in_place[in_place];   ///< the entries while there are at most in_place (only those are set)
+    std::vector<Entry> m_beyond;  ///< all of them once there are more
+};
 
 /// One light as a hit point x sees it, which is all the local terms need of it: l, n·l (as
 /// the convention counts it), and I_i as it arrives at x (times the kt of the transmitting
