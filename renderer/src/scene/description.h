@@ -181,7 +181,8 @@ struct MeshShape {
     std::vector<Vec3> vertices;
     SourceLocation triangles_where;
     std::vector<std::array<int64_t, 3>> triangles;
-    std::vector<SourceLocation> triangle_where;  ///< one per triangle, for index errors
+    /// One per triangle, for index errors; empty where the reader made the indices (NFF).
+    std::vector<SourceLocation> triangle_where;
     SourceLocation normals_where;
     std::vector<Vec3> normals;
     Located<std::string> file;  ///< as written in the scene; `given` for a mesh from a file

@@ -399,10 +399,10 @@ private:
                                               " triangles in the scene's polygons (docs/nff.md, limits)");
         mesh.vertices.insert(mesh.vertices.end(), m_corners.begin(), m_corners.end());
         if (patch) mesh.normals.insert(mesh.normals.end(), m_normals.begin(), m_normals.end());
-        for (size_t i = 0; i + 2 < triangles.size(); i += 3) {
+        // No triangle_where: the reader makes the indices, none can be out of range, and on the
+        // VMs measured the 16 bytes a triangle of fresh memory cost mount -s 9 a tenth of its read.
+        for (size_t i = 0; i + 2 < triangles.size(); i += 3)
             mesh.triangles.push_back({first + triangles[i], first + triangles[i + 1], first + triangles[i + 2]});
-            mesh.triangle_where.push_back(where(code));
-        }
     }
 
     /// An object is handed on (to the sink, or to the description's list) when it is complete:

@@ -420,14 +420,16 @@ private:
         mesh.material = resolve_material(object);
         set_positions(
             mesh, n, [&](size_t i) { return to_world.apply_point(shape.vertices[i]); }, shape.vertices_where);
+        mesh.indices.reserve(3 * shape.triangles.size());
         for (size_t t = 0; t < shape.triangles.size(); ++t)
             for (const int64_t index : shape.triangles[t]) {
                 if (index < 0 || index >= static_cast<int64_t>(n))
-                    fail(shape.triangle_where[t], "mesh.triangles[" + std::to_string(t) + "]: vertex index " +
-                                                      std::to_string(index) + " is out of range (0.." +
-                                                      std::to_string(n - 1) + ")");
+                    fail(t < shape.triangle_where.size() ? shape.triangle_where[t] : shape.triangles_where,
+                         "mesh.triangles[" + std::to_string(t) + "]: vertex index " + std::to_string(index) +
+                             " is out of range (0.." + std::to_string(n - 1) + ")");
                 mesh.indices.push_back(static_cast<uint32_t>(index));
             }
+        mesh.normals.reserve(3 * shape.normals.size());
         for (size_t i = 0; i < shape.normals.size(); ++i) {
             if (is_zero(shape.normals[i]))
                 fail(shape.normals_where, "mesh.normals[" + std::to_string(i) + "] must not be the zero vector");
