@@ -24,9 +24,12 @@
 // each band of rows goes through OpenColorIO with a 64 KiB scratch buffer of its own: on some
 // images (SPD `tetra -s 5`, 512x512) a thread's heap was cut back and regrown for every band,
 // and the write took 24 ms instead of 7. So keep_freed_memory fixes both thresholds: blocks
-// under populated_from() always come from the heaps, and up to 64 MiB freed at a heap's top
-// is kept. Larger blocks are mapped and given back as before. Measured in docs/performance.md
-// ("Design choices and what they cost").
+// under 8 MiB always come from the heaps, and up to 64 MiB freed at a heap's top is kept.
+// Larger blocks are mapped and given back as before. The heaps take blocks up to 8 MiB, not
+// just up to the 1 MiB from which blocks are populated, because a block the heap gives again
+// is written memory, which costs a fresh one's first writes nowhere: the arrays a reader grows
+// by doubling and frees, a mesh's arrays made and let go while the scene is loaded. Measured in
+// docs/performance.md ("Design choices and what they cost").
 //
 // Only the program replaces operator new: the library (libwhitted, the Python module) leaves
 // its host's allocator alone. Memory from here is malloc's and operator delete frees it. Under
@@ -88,6 +91,9 @@ void populate(void* block, size_t size) {
     if (end > first) ::madvise(reinterpret_cast<void*>(first), end - first, MADV_POPULATE_WRITE);
 }
 
+size_t mapped_from() {
+    return size_t(8) << 20;
+}
 size_t kept_free() {
     return size_t(64) << 20;
 }
@@ -95,7 +101,7 @@ size_t kept_free() {
 void keep_freed_memory() {
 #ifndef WHITTED_SANITIZED_NEW
     // Each call also stops glibc moving the other threshold (mallopt(3)): both are set.
-    ::mallopt(M_MMAP_THRESHOLD, int(populated_from()));
+    ::mallopt(M_MMAP_THRESHOLD, int(mapped_from()));
     ::mallopt(M_TRIM_THRESHOLD, int(kept_free()));
 #endif
 }

@@ -16,10 +16,11 @@ bool replaces_operator_new();
 void populate(void* block, size_t size);
 
 /// malloc's thresholds for the program (large_blocks.cpp, "Smaller blocks"): blocks under
-/// populated_from() come from malloc's heaps, and up to kept_free() bytes freed at a heap's top
-/// stay there for the next block instead of going back to the kernel. Called at the start of
-/// main, before any thread; does nothing under a sanitizer, whose allocator is its own.
+/// mapped_from() (8 MiB) come from malloc's heaps, and up to kept_free() bytes freed at a
+/// heap's top stay there for the next block instead of going back to the kernel. Called at the
+/// start of main, before any thread; does nothing under a sanitizer, whose allocator is its own.
 void keep_freed_memory();
+size_t mapped_from();
 size_t kept_free();
 
 }  // namespace whitted::large_blocks

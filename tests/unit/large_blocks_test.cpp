@@ -6,6 +6,7 @@
 #include "large_blocks.h"
 
 #include <gtest/gtest.h>
+#include <malloc.h>
 #include <sys/mman.h>
 #include <sys/resource.h>
 #include <unistd.h>
@@ -176,6 +177,23 @@ TEST(LargeBlocks, SmallBlocksFreedAndAskedForAgainCostNoPageFaults) {
     EXPECT_EQ(sink, 3);
     EXPECT_LE(after - first, 10) << "page faults in 100 rounds after the first";
     EXPECT_EQ(blocks::kept_free(), size_t(64) << 20);
+}
+
+TEST(LargeBlocks, BlocksUnderEightMebibytesComeFromTheHeaps) {
+    if (!blocks::replaces_operator_new()) GTEST_SKIP() << "the sanitizer's allocator is its own";
+    blocks::keep_freed_memory();
+    EXPECT_EQ(blocks::mapped_from(), size_t(8) << 20);
+    // mallinfo2's hblks: the blocks malloc has mapped on their own (and will give back).
+    const size_t before = mallinfo2().hblks;
+    void* heap = std::malloc(blocks::mapped_from() - 4096);
+    const size_t after_heap = mallinfo2().hblks;
+    void* mapped = std::malloc(blocks::mapped_from());
+    const size_t after_mapped = mallinfo2().hblks;
+    ASSERT_TRUE(heap && mapped);
+    std::free(mapped);
+    std::free(heap);
+    EXPECT_EQ(after_heap, before) << "a block just under the threshold was mapped on its own";
+    EXPECT_EQ(after_mapped, before + 1) << "a block of the threshold came from a heap";
 }
 
 TEST(LargeBlocks, ZeroBytesGiveDistinctBlocks) {
