@@ -108,8 +108,8 @@ private:
     static constexpr size_t in_place = 4;
     const Entry* data() const { return m_count > in_place ? m_beyond.data() : m_in_place; }
     size_t m_count = 0;
-    Entry m_in_place[in_place];   ///< the entries while there are at most in_place (only those are set)
-    std::vector<Entry> m_beyond;  ///< all of them once there are more
+    Entry m_in_place[in_place] = {};  ///< the entries while there are at most in_place
+    std::vector<Entry> m_beyond;      ///< all of them once there are more
 };
 
 /// One light as a hit point x sees it, which is all the local terms need of it: l, n·l (as
