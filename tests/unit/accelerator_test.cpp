@@ -252,6 +252,78 @@ TEST_P(PacketsPerIsa, RandomRaysGetTheSingleRayAnswer) {
     EXPECT_GT(blocked_seen, 500);
 }
 
+// A shadow walk asks for hits without their normals (HitParts::without_normals): it must get
+// the same hit as a query that asks for everything, in packets and alone, with the normals
+// left as they were (zero). The scene has every shape kind, two instances of a smooth mesh among
+// them, and random rays from anywhere (inside the shapes too).
+TEST(Accelerator, HitsWithoutNormalsAreTheSameHits) {
+    const Scene scene = test::scene_from(test::join_lines({
+        "camera: {eye: [0, 1, 6], look_at: [0, 0, 0]}",
+        "image: {width: 8, height: 8}",
+        "materials: {a: {kd: 0.5}, b: {kd: 0.7}, c: {kd: 0.2, kt: 0.8, ior: 1.5}}",
+        "prototypes:",
+        "  tri: {type: mesh, material: b, vertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.5]],",
+        "        triangles: [[0, 1, 2], [1, 3, 2]], normals: [[0, 0, 1], [0.3, 0, 1], [0, 0.3, 1], [0.2, 0.2, 1]]}",
+        "objects:",
+        "  - {type: sphere, center: [-1, 0, 0], radius: 0.8, material: a}",
+        "  - {type: box, min: [0.4, -1, -0.5], max: [1.4, 0.2, 0.5], material: b}",
+        "  - {type: triangle, vertices: [[-2, -1, -2], [2, -1, -2], [0, 2, -2.5]], material: c}",
+        "  - {type: plane, point: [0, -1, 0], normal: [0, 1, 0], material: a}",
+        "  - {type: instance, prototype: tri, transform: [{scale: [2, 3, -1]}, {translate: [-1, 0, 1]}]}",
+        "  - {type: instance, prototype: tri, material: c, transform: {rotate: {axis: [0, 1, 0], angle: 30}}}",
+        "  - {type: sphere, center: [0, 1.5, 0], radius: 0.3, material: c}",
+    }));
+    ASSERT_EQ(scene.instances.size(), 2u);
+    const Accelerator accelerator(scene, 2);
+    std::mt19937_64 random(20261206);
+    std::uniform_real_distribution<double> coordinate(-3, 3), unit(-1, 1), chance(0, 1);
+    constexpr int lanes = Accelerator::packet_size;
+    int hits_seen = 0, instance_hits_seen = 0;
+    for (int packet = 0; packet < 300; ++packet) {
+        Ray rays[lanes];
+        bool active[lanes];
+        for (int i = 0; i < lanes; ++i) {
+            Vec3 direction;
+            do direction = {unit(random), unit(random), unit(random)};
+            while (length(direction) < 0.1);
+            rays[i] = {{coordinate(random), coordinate(random), coordinate(random)},
+                       normalize(direction),
+                       1e-4,
+                       chance(random) < 0.5 ? 1e7 : 0.5 + 5 * chance(random)};
+            active[i] = chance(random) < 0.8;
+        }
+        SurfaceHit all[lanes], bare[lanes];
+        bool found_all[lanes] = {}, found_bare[lanes] = {};
+        accelerator.intersect_packet(rays, active, lanes, all, found_all);
+        accelerator.intersect_packet(rays, active, lanes, bare, found_bare, HitParts::without_normals);
+        for (int i = 0; i < lanes; ++i) {
+            if (!active[i]) continue;
+            SCOPED_TRACE("packet " + std::to_string(packet) + " lane " + std::to_string(i));
+            SurfaceHit alone;
+            const bool found_alone = accelerator.intersect(rays[i], alone, HitParts::without_normals);
+            ASSERT_EQ(found_bare[i], found_all[i]);
+            ASSERT_EQ(found_alone, found_all[i]);
+            if (!found_all[i]) continue;
+            ++hits_seen;
+            instance_hits_seen += all[i].object == 5 || all[i].object == 6;
+            for (const SurfaceHit* hit : {&bare[i], &alone}) {
+                EXPECT_EQ(hit->t, all[i].t);
+                EXPECT_EQ(hit->point.x, all[i].point.x);
+                EXPECT_EQ(hit->point.y, all[i].point.y);
+                EXPECT_EQ(hit->point.z, all[i].point.z);
+                EXPECT_EQ(hit->material, all[i].material);
+                EXPECT_EQ(hit->object, all[i].object);
+                EXPECT_EQ(length(hit->normal), 0.0);
+                EXPECT_EQ(length(hit->geometric_normal), 0.0);
+            }
+            EXPECT_NEAR(length(all[i].normal), 1.0, 1e-12);
+        }
+    }
+    // The rays must have met the shapes, the instances among them, or the comparison proves little.
+    EXPECT_GT(hits_seen, 1000);
+    EXPECT_GT(instance_hits_seen, 50);
+}
+
 INSTANTIATE_TEST_SUITE_P(EveryIsa, PacketsPerIsa, testing::ValuesIn(embree_isa_names()),
                          [](const testing::TestParamInfo<std::string>& param) {
                              std::string name = param.param;

@@ -27,16 +27,16 @@ size_t Accelerator::peak_embree_bytes() const {
 size_t Accelerator::embree_bytes() const {
     return size_t(std::max<int64_t>(0, m_impl->memory.current.load()));
 }
-bool Accelerator::intersect(const Ray& ray, SurfaceHit& hit) const {
-    return m_impl->intersect(ray, hit);
+bool Accelerator::intersect(const Ray& ray, SurfaceHit& hit, HitParts parts) const {
+    return m_impl->intersect(ray, hit, parts);
 }
 bool Accelerator::occluded(const Ray& ray) const {
     return m_impl->occluded(ray);
 }
 
-void Accelerator::intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits,
-                                   bool* found) const {
-    m_impl->intersect_packet(rays, active, count, hits, found);
+void Accelerator::intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found,
+                                   HitParts parts) const {
+    m_impl->intersect_packet(rays, active, count, hits, found, parts);
 }
 void Accelerator::occluded_packet(const Ray* rays, const bool* active, int count, bool* blocked) const {
     m_impl->occluded_packet(rays, active, count, blocked);

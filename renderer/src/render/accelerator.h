@@ -25,6 +25,10 @@ struct SurfaceHit {
     uint32_t object = 0;  ///< Scene::objects index + 1 (SceneObject): the objectId layer
 };
 
+/// What a query fills in a SurfaceHit: all of it, or all but the two normals (left zero), for a
+/// shadow walk, which needs only where it met what. The hit itself is the same either way.
+enum class HitParts { all, without_normals };
+
 /// Ray queries over a Scene. Embree's BVH finds the candidates (triangles natively, spheres and
 /// boxes as user geometry intersected in double); infinite planes are tested directly. The hit
 /// that wins is recomputed in double from the double ray, so shading sees POV-Ray's precision.
@@ -45,7 +49,7 @@ public:
     size_t peak_embree_bytes() const;
 
     /// Nearest hit with ray.t_min < t < ray.t_max.
-    bool intersect(const Ray& ray, SurfaceHit& hit) const;
+    bool intersect(const Ray& ray, SurfaceHit& hit, HitParts parts = HitParts::all) const;
     /// Whether anything lies strictly between ray.t_min and ray.t_max (shadow rays).
     bool occluded(const Ray& ray) const;
 
@@ -61,7 +65,8 @@ public:
     int lane_width() const;
     /// The instruction set asked for ("" = Embree's choice), as given to the constructor.
     const std::string& isa() const;
-    void intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found) const;
+    void intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found,
+                          HitParts parts = HitParts::all) const;
     void occluded_packet(const Ray* rays, const bool* active, int count, bool* blocked) const;
 
 private:

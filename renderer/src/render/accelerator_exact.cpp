@@ -359,7 +359,9 @@ const PovrayTestOrder& Accelerator::Impl::tie_order() const {
 /// `inst`: Embree's instance geomID when the candidate is a prototype's triangle (`geom` is
 /// then its mesh in the prototype), else RTC_INVALID_GEOMETRY_ID.
 bool Accelerator::Impl::finish_hit(const Ray& ray, unsigned inst, unsigned geom, unsigned prim, double best_t,
-                                   const Vec3& best_normal, bool tied, SurfaceHit& out, bool& retry) const {
+                                   const Vec3& best_normal, bool tied, HitParts parts, SurfaceHit& out,
+                                   bool& retry) const {
+    const bool normals = parts == HitParts::all;
     retry = false;
     bool found = false;
     double t_max = ray.t_max;
@@ -397,14 +399,16 @@ bool Accelerator::Impl::finish_hit(const Ray& ray, unsigned inst, unsigned geom,
             if (!tested &&
                 !hit_triangle_in_double(mesh, prim, to_object_space(to_world, ray), povray.decided, true, hit))
                 return retry = true, false;
-            const double handedness = to_world.determinant() < 0 ? -1.0 : 1.0;
-            out.geometric_normal = normalize(to_world.apply_normal(hit.normal)) * handedness;
-            Vec3 smooth;
-            // POV-Ray takes the world point back into the mesh's space for its normal.
-            out.normal =
-                smooth_normal(mesh, prim, hit, povray, to_world.inverse_point(ray.at(hit.t)), scene.convention, smooth)
-                    ? normalize(to_world.apply_normal(smooth))
-                    : out.geometric_normal;
+            if (normals) {
+                const double handedness = to_world.determinant() < 0 ? -1.0 : 1.0;
+                out.geometric_normal = normalize(to_world.apply_normal(hit.normal)) * handedness;
+                Vec3 smooth;
+                // POV-Ray takes the world point back into the mesh's space for its normal.
+                out.normal = smooth_normal(mesh, prim, hit, povray, to_world.inverse_point(ray.at(hit.t)),
+                                           scene.convention, smooth)
+                                 ? normalize(to_world.apply_normal(smooth))
+                                 : out.geometric_normal;
+            }
             out.material = triangle_material(instance, mesh, prim);
             out.object = instance.object;
         } else if (kinds[geom] == ShapeKind::triangles) {
@@ -412,11 +416,13 @@ bool Accelerator::Impl::finish_hit(const Ray& ray, unsigned inst, unsigned geom,
             const MeshAsPovray& povray = world_povray[mesh_of_geometry[geom]];
             if (!tested && !hit_triangle_in_double(mesh, prim, ray, povray.decided, false, hit))
                 return retry = true, false;
-            out.geometric_normal = normalize(hit.normal);
-            Vec3 smooth;
-            out.normal = smooth_normal(mesh, prim, hit, povray, ray.at(hit.t), scene.convention, smooth)
-                             ? smooth
-                             : out.geometric_normal;
+            if (normals) {
+                out.geometric_normal = normalize(hit.normal);
+                Vec3 smooth;
+                out.normal = smooth_normal(mesh, prim, hit, povray, ray.at(hit.t), scene.convention, smooth)
+                                 ? smooth
+                                 : out.geometric_normal;
+            }
             out.material = triangle_material(mesh, prim);
             out.object = mesh.object;
         } else {
@@ -429,7 +435,7 @@ bool Accelerator::Impl::finish_hit(const Ray& ray, unsigned inst, unsigned geom,
             if (tied && tie_order().nearest(ray, first, best_t) && first.hit.t == best_t)
                 kind = first.sphere ? ShapeKind::spheres : ShapeKind::boxes, prim = first.index,
                 normal = first.hit.normal;
-            out.normal = out.geometric_normal = normalize(normal);
+            if (normals) out.normal = out.geometric_normal = normalize(normal);
             std::tie(out.material, out.object) = material_and_object(scene, kind, prim);
         }
         out.t = hit.t;
@@ -452,7 +458,7 @@ bool Accelerator::Impl::finish_hit(const Ray& ray, unsigned inst, unsigned geom,
         if (!povray && found && !(plane_hit.t < t_max - window) && plane.object > out.object) continue;
         t_max = plane_hit.t;
         out.t = plane_hit.t;
-        out.normal = out.geometric_normal = plane.normal;
+        if (normals) out.normal = out.geometric_normal = plane.normal;
         out.material = plane.material;
         out.object = plane.object;
         found = plane_found = true;
@@ -462,31 +468,31 @@ bool Accelerator::Impl::finish_hit(const Ray& ray, unsigned inst, unsigned geom,
 }
 
 /// The nearest hit on `ray`: Embree's nearest candidate, when the double test accepts it.
-bool Accelerator::Impl::intersect(const Ray& ray, SurfaceHit& out) const {
-    return starts_afar(ray) ? intersect_from_afar(ray, out) : intersect_from_here(ray, out);
+bool Accelerator::Impl::intersect(const Ray& ray, SurfaceHit& out, HitParts parts) const {
+    return starts_afar(ray) ? intersect_from_afar(ray, out, parts) : intersect_from_here(ray, out, parts);
 }
 
 /// intersect for a ray that does not start afar (or has been brought near).
-bool Accelerator::Impl::intersect_from_here(const Ray& ray, SurfaceHit& out) const {
+bool Accelerator::Impl::intersect_from_here(const Ray& ray, SurfaceHit& out, HitParts parts) const {
     bool retry = false;
-    const bool found = trace(ray, nullptr, out, retry);
-    return retry ? intersect_again(ray, out) : found;
+    const bool found = trace(ray, nullptr, parts, out, retry);
+    return retry ? intersect_again(ray, out, parts) : found;
 }
 
 /// intersect for a ray that starts_afar: a plane it meets before it reaches the finite shapes'
 /// cube, else what it meets from there on (toward_finite_shapes).
-bool Accelerator::Impl::intersect_from_afar(const Ray& ray, SurfaceHit& out) const {
+bool Accelerator::Impl::intersect_from_afar(const Ray& ray, SurfaceHit& out, HitParts parts) const {
     Ray near;
     double skipped = 0;
     bool retry = false;
     if (!toward_finite_shapes(ray, near, skipped))
-        return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, {}, false, out, retry);
+        return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, {}, false, parts, out, retry);
     Ray before = ray;
     before.t_max = std::min(ray.t_max, skipped);
     if (before.t_max > before.t_min &&
-        finish_hit(before, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, {}, false, out, retry))
+        finish_hit(before, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, {}, false, parts, out, retry))
         return true;
-    if (!intersect_from_here(near, out)) return false;
+    if (!intersect_from_here(near, out, parts)) return false;
     out.t += skipped;
     return true;
 }
@@ -495,16 +501,17 @@ bool Accelerator::Impl::intersect_from_afar(const Ray& ray, SurfaceHit& out) con
 /// traced again with that test as Embree's filter, so that Embree goes on past every
 /// refused candidate to the nearest accepted one. Only such rays pay for the filter's call
 /// per candidate (a few percent of the rays that meet a mesh, those near an edge).
-bool Accelerator::Impl::intersect_again(const Ray& ray, SurfaceHit& out) const {
+bool Accelerator::Impl::intersect_again(const Ray& ray, SurfaceHit& out, HitParts parts) const {
     bool retry = false;
-    const bool found = trace(ray, triangle_filter, out, retry);
+    const bool found = trace(ray, triangle_filter, parts, out, retry);
     if (!retry) return found;
     // Not expected (the filter refuses what finish_hit would); if it came, the planes answer.
-    return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, {}, false, out, retry);
+    return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0, 0, {}, false, parts, out, retry);
 }
 
 /// One Embree query for `ray` with `filter` on its context (null: none), and finish_hit.
-bool Accelerator::Impl::trace(const Ray& ray, RTCFilterFunctionN filter, SurfaceHit& out, bool& retry) const {
+bool Accelerator::Impl::trace(const Ray& ray, RTCFilterFunctionN filter, HitParts parts, SurfaceHit& out,
+                              bool& retry) const {
     QueryContext context(&ray, nullptr, 1, false);
     context.embree.filter = filter;
     context.start(0, ray);
@@ -514,7 +521,7 @@ bool Accelerator::Impl::trace(const Ray& ray, RTCFilterFunctionN filter, Surface
     rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(rtc_scene, &context.embree, &rayhit);
     return finish_hit(ray, rayhit.hit.instID[0], rayhit.hit.geomID, rayhit.hit.primID, context.best_t[0],
-                      context.best_normal[0], context.best_tied[0], out, retry);
+                      context.best_normal[0], context.best_tied[0], parts, out, retry);
 }
 
 /// Calls `lanes.operator()<W>(first)` for first = 0, W, 2W, ... < count, with W the native

@@ -286,7 +286,7 @@ struct Accelerator::Impl {
     // The exact decision, one ray at a time (accelerator_exact.cpp).
     const PovrayTestOrder& tie_order() const;
     bool finish_hit(const Ray& ray, unsigned inst, unsigned geom, unsigned prim, double best_t, const Vec3& best_normal,
-                    bool tied, SurfaceHit& out, bool& retry) const;
+                    bool tied, HitParts parts, SurfaceHit& out, bool& retry) const;
     void nearest_triangle(const Ray& ray, double t, unsigned& inst, unsigned& geom, unsigned& prim) const;
     double triangle_stray(double t) const;
     bool may_meet_another_object(const Ray& ray, unsigned top, double t) const;
@@ -302,11 +302,11 @@ struct Accelerator::Impl {
     std::vector<WorldBox> tie_neighbours;
     double tie_neighbour_margin = 0;
     void find_tie_neighbours();
-    bool intersect(const Ray& ray, SurfaceHit& out) const;
-    bool intersect_from_here(const Ray& ray, SurfaceHit& out) const;
-    bool intersect_from_afar(const Ray& ray, SurfaceHit& out) const;
-    bool intersect_again(const Ray& ray, SurfaceHit& out) const;
-    bool trace(const Ray& ray, RTCFilterFunctionN filter, SurfaceHit& out, bool& retry) const;
+    bool intersect(const Ray& ray, SurfaceHit& out, HitParts parts) const;
+    bool intersect_from_here(const Ray& ray, SurfaceHit& out, HitParts parts) const;
+    bool intersect_from_afar(const Ray& ray, SurfaceHit& out, HitParts parts) const;
+    bool intersect_again(const Ray& ray, SurfaceHit& out, HitParts parts) const;
+    bool trace(const Ray& ray, RTCFilterFunctionN filter, HitParts parts, SurfaceHit& out, bool& retry) const;
     bool occluded(const Ray& ray) const;
     bool occluded_in_bvh(const Ray& ray) const;
 
@@ -328,13 +328,14 @@ struct Accelerator::Impl {
     bool in_native_groups(int count, Lanes&& lanes) const;
     template <int W>
     void intersect_lanes(accel::QueryContext& context, const Ray* rays, const bool* query, int first, int count,
-                         SurfaceHit* hits, bool* found) const;
+                         HitParts parts, SurfaceHit* hits, bool* found) const;
     template <int W>
     void occluded_lanes(accel::QueryContext& context, const Ray* rays, const bool* query, int first, int count,
                         bool* blocked) const;
     template <class Alone>
     const bool* without_rays_from_afar(const Ray* rays, const bool* active, int count, bool* kept, Alone&& alone) const;
-    void intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found) const;
+    void intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found,
+                          HitParts parts) const;
     void occluded_packet(const Ray* rays, const bool* active, int count, bool* blocked) const;
 };
 

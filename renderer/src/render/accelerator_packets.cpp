@@ -127,7 +127,7 @@ bool Accelerator::Impl::in_native_groups(int count, Lanes&& lanes) const {
 /// a query, or an empty lane (set_empty_lane).
 template <int W>
 void Accelerator::Impl::intersect_lanes(QueryContext& context, const Ray* rays, const bool* query, int first, int count,
-                                        SurfaceHit* hits, bool* found) const {
+                                        HitParts parts, SurfaceHit* hits, bool* found) const {
     alignas(64) int valid[W];
     alignas(64) typename EmbreePacket<W>::RayHit packet;
     bool any = false;
@@ -152,8 +152,8 @@ void Accelerator::Impl::intersect_lanes(QueryContext& context, const Ray* rays, 
         if (!valid[lane]) continue;
         bool retry = false;
         found[i] = finish_hit(rays[i], packet.hit.instID[0][lane], packet.hit.geomID[lane], packet.hit.primID[lane],
-                              context.best_t[i], context.best_normal[i], context.best_tied[i], hits[i], retry);
-        if (retry) found[i] = intersect_again(rays[i], hits[i]);
+                              context.best_t[i], context.best_normal[i], context.best_tied[i], parts, hits[i], retry);
+        if (retry) found[i] = intersect_again(rays[i], hits[i], parts);
     }
 }
 
@@ -173,11 +173,11 @@ const bool* Accelerator::Impl::without_rays_from_afar(const Ray* rays, const boo
     return kept;
 }
 
-void Accelerator::Impl::intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits,
-                                         bool* found) const {
+void Accelerator::Impl::intersect_packet(const Ray* rays, const bool* active, int count, SurfaceHit* hits, bool* found,
+                                         HitParts parts) const {
     bool from_here[packet_size];
     active = without_rays_from_afar(rays, active, count, from_here,
-                                    [&](int i) { found[i] = intersect_from_afar(rays[i], hits[i]); });
+                                    [&](int i) { found[i] = intersect_from_afar(rays[i], hits[i], parts); });
     // A few rays (a refracted path, the last steps of a shadow walk) go one by one through
     // Embree's single-ray traversal: a W-wide packet with one lane in use walks the same nodes
     // at W lanes' cost; so do all rays where Embree has no packets (in_native_groups). The
@@ -185,12 +185,13 @@ void Accelerator::Impl::intersect_packet(const Ray* rays, const bool* active, in
     bool traced = false;
     if (!few_lanes(active, count, single_ray_lanes)) {
         QueryContext context(rays, active, count, true);
-        traced = in_native_groups(
-            count, [&]<int W>(int first) { intersect_lanes<W>(context, rays, active, first, count, hits, found); });
+        traced = in_native_groups(count, [&]<int W>(int first) {
+            intersect_lanes<W>(context, rays, active, first, count, parts, hits, found);
+        });
     }
     if (!traced)
         for (int i = 0; i < count; ++i)
-            if (active[i]) found[i] = intersect(rays[i], hits[i]);
+            if (active[i]) found[i] = intersect(rays[i], hits[i], parts);
     embree_error.throw_if_failed("while tracing rays");
 }
 

@@ -247,7 +247,7 @@ void LectureShading::shadow_filters(Ray* shadow_rays, const bool* tested, int co
     PacketArray<SurfaceHit, packet_size> hits;
     bool found[packet_size];
     while (left > 0) {
-        m_accelerator.intersect_packet(shadow_rays, walking, count, hits.data(), found);
+        m_accelerator.intersect_packet(shadow_rays, walking, count, hits.data(), found, HitParts::without_normals);
         for (int i = 0; i < count; ++i) {
             if (!walking[i]) continue;
             bool ends = !found[i];
