@@ -112,22 +112,81 @@ bool run(PngJob& job) {
     return true;
 }
 
+/// Rows of PNG samples from the linear image: the display transform, then each value rounded to
+/// its nearest code (8 or 16 bits, big-endian).
+class Samples {
+public:
+    /// Rows go through the display transform this many at a time, from a multiple of it, so that
+    /// every row is transformed in the same company whichever band asks for it.
+    static constexpr int chunk_rows = 8;
+
+    Samples(const Image& linear, const DisplayTransform& display, int bits)
+        : m_linear(linear), m_display(display), m_bits(bits), m_row_samples(3 * size_t(linear.width)) {}
+    size_t row_samples() const { return m_row_samples; }
+    size_t row_bytes() const { return m_row_samples * size_t(m_bits / 8); }
+
+    /// Rows [first, first + count) to out, `stride` bytes apart; `first` a multiple of
+    /// chunk_rows. `values`: room for chunk_rows rows of floats.
+    void rows(int first, int count, unsigned char* out, size_t stride, float* values) const {
+        // In double, the product and the half are exact, so every value rounds to its nearest
+        // code (in float, 0.7f * 255 + 0.5f came out 179, not 178).
+        const double scale = m_bits == 16 ? 65535.0 : 255.0;
+        for (int chunk = first; chunk < first + count; chunk += chunk_rows) {
+            const int rows = std::min(chunk_rows, m_linear.height - chunk);
+            const size_t samples = m_row_samples * size_t(rows);
+            std::copy_n(m_linear.rgb.begin() + std::ptrdiff_t(m_row_samples * size_t(chunk)), samples, values);
+            m_display.apply(values, size_t(m_linear.width) * size_t(rows));
+            for (int r = 0; r < std::min(rows, first + count - chunk); ++r) {
+                const float* from = values + m_row_samples * size_t(r);
+                unsigned char* to = out + stride * size_t(chunk - first + r);
+                for (size_t i = 0; i < m_row_samples; ++i) {
+                    const float v = from[i] > 0 ? std::min(from[i], 1.0f) : 0.0f;  // NaN fails `> 0`
+                    const auto code = static_cast<uint32_t>(double(v) * scale + 0.5);
+                    if (m_bits == 16) {
+                        to[2 * i] = static_cast<unsigned char>(code >> 8);
+                        to[2 * i + 1] = static_cast<unsigned char>(code & 0xFF);
+                    } else {
+                        to[i] = static_cast<unsigned char>(code);
+                    }
+                }
+            }
+        }
+    }
+    /// Row `y` alone (the row above a band), in `room` (chunk_rows rows), where it is returned;
+    /// the rows of its chunk go through the display transform with it.
+    const unsigned char* row(int y, unsigned char* room, float* values) const {
+        const int first = y - y % chunk_rows;
+        rows(first, y - first + 1, room, row_bytes(), values);
+        return room + row_bytes() * size_t(y - first);
+    }
+
+private:
+    const Image& m_linear;
+    const DisplayTransform& m_display;
+    int m_bits;
+    size_t m_row_samples;
+};
+
 /// The zlib stream of a PNG's image data: each row as the "up" filter (the difference from the
-/// row above) behind its filter-type byte, deflated at level 1. Bands of rows are deflated on
-/// all cores, each as its own run of deflate blocks ended on a byte boundary (Z_SYNC_FLUSH),
-/// and joined, the way pigz does it; their Adler-32 sums combine into the stream's. zlib's
-/// level 6 took 0.13 s for a 1280x960 8-bit image and level 1 on one core 0.022 s (8 bits) or
-/// about 0.1 s (16 bits); see docs/performance.md.
+/// row above) behind its filter-type byte, deflated at level 1. Bands of rows are made from the
+/// linear image (Samples), filtered and deflated on all cores, each band as its own run of
+/// deflate blocks ended on a byte boundary (Z_SYNC_FLUSH), and joined, the way pigz does it;
+/// their Adler-32 sums combine into the stream's. zlib's level 6 took 0.13 s for a 1280x960
+/// 8-bit image and level 1 on one core 0.022 s (8 bits) or about 0.1 s (16 bits); see
+/// docs/performance.md. No image-sized buffer of samples is made: a band's rows are written
+/// where their filtered form goes, and filtered in place from the bottom up.
 ///
 /// Its buffers are not zeroed first: every byte of a band's filtered rows is written, and of its
 /// deflate output only what deflate wrote is kept (a zeroed output buffer, deflate's bound, was
 /// mostly never written, and each of its fresh pages is a page fault, docs/performance.md).
-std::vector<unsigned char> compress_rows(const unsigned char* rows, size_t row_bytes, int height, int bits) {
+std::vector<unsigned char> compress_rows(const Samples& samples, int height, int bits) {
     // 16-bit rows have noisy low bytes where deflate's string matching rarely pays: run-length
     // matching only was twice as fast on the spheres anchor (0.037 s against 0.072 s on one
     // core) for 16 % more bytes. On 8-bit rows it was no faster.
     const int strategy = bits == 16 ? Z_RLE : Z_DEFAULT_STRATEGY;
     constexpr int band = 64;
+    static_assert(band % Samples::chunk_rows == 0);
+    const size_t row_bytes = samples.row_bytes();
     const int bands = (height + band - 1) / band;
     const auto band_count = static_cast<size_t>(bands);
     struct Part {
@@ -140,18 +199,24 @@ std::vector<unsigned char> compress_rows(const unsigned char* rows, size_t row_b
     std::atomic<bool> failed{false};
     tbb::parallel_for(0, bands, [&](int b) {
         const int first = b * band, count = std::min(band, height - first);
-        const size_t filtered_size = size_t(count) * (row_bytes + 1);
+        const size_t stride = row_bytes + 1, filtered_size = size_t(count) * stride;
         const auto filtered = std::make_unique_for_overwrite<unsigned char[]>(filtered_size);
-        for (int y = first; y < first + count; ++y) {
-            unsigned char* out = filtered.get() + size_t(y - first) * (row_bytes + 1);
-            const unsigned char* row = rows + size_t(y) * row_bytes;
+        const auto values = std::make_unique_for_overwrite<float[]>(samples.row_samples() * Samples::chunk_rows);
+        // The band's rows, each behind room for its filter-type byte; then each row less the one
+        // above it, from the last row up, so that the row above is still whole when it is used.
+        samples.rows(first, count, filtered.get() + 1, stride, values.get());
+        for (int y = count - 1; y > 0; --y) {
+            unsigned char* out = filtered.get() + size_t(y) * stride;
+            const unsigned char* above = out - stride;
             out[0] = 2;  // PNG filter type 2, "up"
-            if (y == 0) {
-                std::memcpy(out + 1, row, row_bytes);
-            } else {
-                const unsigned char* above = row - row_bytes;
-                for (size_t i = 0; i < row_bytes; ++i) out[1 + i] = static_cast<unsigned char>(row[i] - above[i]);
-            }
+            for (size_t i = 1; i <= row_bytes; ++i) out[i] = static_cast<unsigned char>(out[i] - above[i]);
+        }
+        filtered[0] = 2;
+        if (first > 0) {
+            const auto room = std::make_unique_for_overwrite<unsigned char[]>(row_bytes * Samples::chunk_rows);
+            const unsigned char* above = samples.row(first - 1, room.get(), values.get());
+            for (size_t i = 0; i < row_bytes; ++i)
+                filtered[1 + i] = static_cast<unsigned char>(filtered[1 + i] - above[i]);
         }
         sums[size_t(b)] = adler32(adler32(0, nullptr, 0), filtered.get(), uInt(filtered_size));
         lengths[size_t(b)] = filtered_size;
@@ -197,33 +262,7 @@ void write_png(const std::string& path, const Image& linear, const DisplayTransf
                const std::vector<std::pair<std::string, std::string>>& metadata) {
     if (bits != 8 && bits != 16) throw std::invalid_argument("PNG files hold 8 or 16 bits per channel");
     const int width = linear.width, height = linear.height;
-    const size_t samples_per_row = 3 * size_t(width);
-    const size_t row_bytes = samples_per_row * size_t(bits / 8);
-    // Not zeroed: the bands write every byte.
-    const auto rows = std::make_unique_for_overwrite<unsigned char[]>(row_bytes * size_t(height));
-    // In double, the product and the half are exact, so every value rounds to its nearest code
-    // (in float, 0.7f * 255 + 0.5f came out 179, not 178).
-    const double scale = bits == 16 ? 65535.0 : 255.0;
-    // Bands of rows on all cores, each through a small buffer (one chunk for the display
-    // transform) rather than a display-referred copy of the whole image.
-    constexpr int band = 8;
-    tbb::parallel_for(0, (height + band - 1) / band, [&](int b) {
-        const int first = b * band, count = std::min(band, height - first);
-        std::vector<float> values(linear.rgb.begin() + std::ptrdiff_t(samples_per_row * size_t(first)),
-                                  linear.rgb.begin() + std::ptrdiff_t(samples_per_row * size_t(first + count)));
-        display.apply(values.data(), size_t(width) * size_t(count));
-        unsigned char* out = rows.get() + row_bytes * size_t(first);
-        for (size_t i = 0; i < values.size(); ++i) {
-            const float v = values[i] > 0 ? std::min(values[i], 1.0f) : 0.0f;  // NaN fails `> 0`
-            const auto code = static_cast<uint32_t>(double(v) * scale + 0.5);
-            if (bits == 16) {  // PNG samples are big-endian
-                out[2 * i] = static_cast<unsigned char>(code >> 8);
-                out[2 * i + 1] = static_cast<unsigned char>(code & 0xFF);
-            } else {
-                out[i] = static_cast<unsigned char>(code);
-            }
-        }
-    });
+    const Samples samples(linear, display, bits);
     // Text chunks: tEXt holds Latin-1, so anything else (a UTF-8 scene path) goes in iTXt.
     std::vector<png_text> texts(metadata.size());
     for (size_t i = 0; i < metadata.size(); ++i) {
@@ -233,9 +272,9 @@ void write_png(const std::string& path, const Image& linear, const DisplayTransf
         texts[i].text_length = metadata[i].second.size();
         texts[i].compression = is_ascii(metadata[i].second) ? PNG_TEXT_COMPRESSION_NONE : PNG_ITXT_COMPRESSION_NONE;
     }
+    const std::vector<unsigned char> idat = compress_rows(samples, height, bits);
     std::FILE* file = std::fopen(path.c_str(), "wb");
     if (!file) throw std::runtime_error("cannot open '" + path + "' for writing: " + std::strerror(errno));
-    const std::vector<unsigned char> idat = compress_rows(rows.get(), row_bytes, height, bits);
     PngJob job{file, width, height, bits, idat.data(), idat.size(), texts.data(), int(texts.size()), display.encoding(),
                {}};
     errno = 0;
