@@ -25,8 +25,9 @@ struct SurfaceHit {
     uint32_t object = 0;  ///< Scene::objects index + 1 (SceneObject): the objectId layer
 };
 
-/// What a query fills in a SurfaceHit: all of it, or all but the two normals (left zero), for a
-/// shadow walk, which needs only where it met what. The hit itself is the same either way.
+/// What a query fills in a SurfaceHit: all of it, or all but the two normals (left as they
+/// were), for a shadow walk, which needs only where it met what. The hit itself is the same
+/// either way.
 enum class HitParts { all, without_normals };
 
 /// Ray queries over a Scene. Embree's BVH finds the candidates (triangles natively, spheres and
