@@ -199,6 +199,18 @@ TEST(PacketsAcrossIsas, HitsAreBitIdentical) {
     }
 }
 
+/// A ray from anywhere within 3 of the origin on each axis, in any direction, with a minimum
+/// distance of 1e-4 or 1e-3 and a reach of 1e7 or 0.5 to 5.5.
+Ray random_ray(std::mt19937_64& random) {
+    std::uniform_real_distribution<double> coordinate(-3, 3), unit(-1, 1), chance(0, 1);
+    Vec3 direction;
+    do direction = {unit(random), unit(random), unit(random)};
+    while (length(direction) < 0.1);
+    const double t_min = chance(random) < 0.5 ? 1e-4 : 1e-3;
+    const double t_max = chance(random) < 0.5 ? 1e7 : 0.5 + 5 * chance(random);
+    return {{coordinate(random), coordinate(random), coordinate(random)}, normalize(direction), t_min, t_max};
+}
+
 // Random rays, from anywhere in and around the scene (inside the sphere and the box too) in any
 // direction, with random minimum distances, in randomly filled packets: the packet answer is
 // the single-ray answer, bit for bit, under each instruction set.
@@ -208,7 +220,7 @@ TEST_P(PacketsPerIsa, RandomRaysGetTheSingleRayAnswer) {
     const Scene scene = test::scene_from(scene_text);
     const Accelerator accelerator(scene, 2, isa);
     std::mt19937_64 random(20261201);
-    std::uniform_real_distribution<double> coordinate(-3, 3), unit(-1, 1), chance(0, 1);
+    std::uniform_real_distribution<double> chance(0, 1);
     constexpr int lanes = Accelerator::packet_size;
     int hits_seen = 0, misses_seen = 0, blocked_seen = 0;
     for (int packet = 0; packet < 400; ++packet) {
@@ -216,13 +228,7 @@ TEST_P(PacketsPerIsa, RandomRaysGetTheSingleRayAnswer) {
         bool active[lanes];
         const int count = 1 + int(chance(random) * lanes) % lanes;
         for (int i = 0; i < lanes; ++i) {
-            Vec3 direction;
-            do direction = {unit(random), unit(random), unit(random)};
-            while (length(direction) < 0.1);
-            const double t_min = chance(random) < 0.5 ? 1e-4 : 1e-3;
-            const double t_max = chance(random) < 0.5 ? 1e7 : 0.5 + 5 * chance(random);
-            rays[i] = {
-                {coordinate(random), coordinate(random), coordinate(random)}, normalize(direction), t_min, t_max};
+            rays[i] = random_ray(random);
             active[i] = chance(random) < 0.8;
         }
         SurfaceHit hits[lanes];
@@ -276,20 +282,14 @@ TEST(Accelerator, HitsWithoutNormalsAreTheSameHits) {
     ASSERT_EQ(scene.instances.size(), 2u);
     const Accelerator accelerator(scene, 2);
     std::mt19937_64 random(20261206);
-    std::uniform_real_distribution<double> coordinate(-3, 3), unit(-1, 1), chance(0, 1);
+    std::uniform_real_distribution<double> chance(0, 1);
     constexpr int lanes = Accelerator::packet_size;
     int hits_seen = 0, instance_hits_seen = 0;
     for (int packet = 0; packet < 300; ++packet) {
         Ray rays[lanes];
         bool active[lanes];
         for (int i = 0; i < lanes; ++i) {
-            Vec3 direction;
-            do direction = {unit(random), unit(random), unit(random)};
-            while (length(direction) < 0.1);
-            rays[i] = {{coordinate(random), coordinate(random), coordinate(random)},
-                       normalize(direction),
-                       1e-4,
-                       chance(random) < 0.5 ? 1e7 : 0.5 + 5 * chance(random)};
+            rays[i] = random_ray(random);
             active[i] = chance(random) < 0.8;
         }
         SurfaceHit all[lanes], bare[lanes];
