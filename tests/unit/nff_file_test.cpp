@@ -12,6 +12,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
 namespace whitted {
 namespace {
@@ -130,6 +131,35 @@ TEST(Nff, PolygonsOfOneFillShareAMeshAndANewFillStartsAnother) {
     EXPECT_EQ(first.triangles[1], (std::array<int64_t, 3>{3, 4, 5}));
     EXPECT_EQ(std::get<MeshShape>(d.objects[1].shape).triangles.size(), 1u);
     EXPECT_EQ(d.objects[1].material->name, "f2");
+}
+
+/// A fill is a material by its eight numbers: a line repeating an earlier fill's (SPD's lattice
+/// alternates five fills over 8,281 objects) names that material again; any number different,
+/// even in the last bit, is a material of its own; an object before any fill gets "f0".
+TEST(Nff, ARepeatedFillIsTheSameMaterial) {
+    const std::string view = "v from 0 0 5 at 0 0 0 up 0 1 0 angle 30 resolution 8 8\n";
+    const std::string sphere = "s 0 0 0 1\n", triangle = "p 3 0 0 0 1 0 0 0 1 0\n";
+    const std::string red = "f 1 0 0 0.5 0.5 3 0 0\n", blue = "f 0 0 1 0.5 0.5 3 0 0\n";
+    const std::string red_but_last_bit = "f 1 0 0 0.5 0.5 3.0000000000000004 0 0\n";
+    const SceneDescription d = parse_nff_text(view + sphere + red + sphere + triangle + blue + sphere + red + sphere +
+                                                  triangle + red_but_last_bit + sphere + "f 1 0 0 .5 .50 3.0 0 0\n" +
+                                                  sphere,
+                                              "fills.nff");
+    ASSERT_EQ(d.materials.size(), 4u);
+    EXPECT_EQ(d.materials[0].name, "f0");
+    EXPECT_EQ(d.materials[1].name, "f2");
+    EXPECT_EQ(d.materials[1].where.line, 3);  // where it was first written
+    EXPECT_EQ(d.materials[2].name, "f3");
+    EXPECT_EQ(d.materials[2].kd.value, Color(0, 0, 0.5));
+    EXPECT_EQ(d.materials[3].name, "f4");
+    EXPECT_EQ(d.materials[3].p.value, 3.0000000000000004);
+    std::vector<std::string> names;
+    for (const ObjectDescription& object : d.objects) names.push_back(object.material->name);
+    // The mesh of a fill is handed on when the next fill starts, after that fill's spheres.
+    EXPECT_EQ(names, (std::vector<std::string>{"f0", "f2", "f2", "f3", "f2", "f2", "f4", "f2"}));
+    ASSERT_EQ(d.objects[2].type(), ObjectType::mesh);
+    ASSERT_EQ(d.objects[5].type(), ObjectType::mesh);  // a new mesh, though its fill is f2 again
+    EXPECT_EQ(std::get<MeshShape>(d.objects[5].shape).triangles.size(), 1u);
 }
 
 /// The area of the triangles a polygon was cut into, against the polygon's own (shoelace).
