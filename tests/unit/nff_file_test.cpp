@@ -141,10 +141,10 @@ TEST(Nff, ARepeatedFillIsTheSameMaterial) {
     const std::string sphere = "s 0 0 0 1\n", triangle = "p 3 0 0 0 1 0 0 0 1 0\n";
     const std::string red = "f 1 0 0 0.5 0.5 3 0 0\n", blue = "f 0 0 1 0.5 0.5 3 0 0\n";
     const std::string red_but_last_bit = "f 1 0 0 0.5 0.5 3.0000000000000004 0 0\n";
-    const SceneDescription d = parse_nff_text(view + sphere + red + sphere + triangle + blue + sphere + red + sphere +
-                                                  triangle + red_but_last_bit + sphere + "f 1 0 0 .5 .50 3.0 0 0\n" +
-                                                  sphere,
-                                              "fills.nff");
+    const SceneDescription d =
+        parse_nff_text(view + sphere + red + sphere + triangle + blue + sphere + red + sphere + triangle +
+                           red_but_last_bit + sphere + "f 1 0 0 .5 .50 3.0 0 0\n" + sphere,
+                       "fills.nff");
     ASSERT_EQ(d.materials.size(), 4u);
     EXPECT_EQ(d.materials[0].name, "f0");
     EXPECT_EQ(d.materials[1].name, "f2");
