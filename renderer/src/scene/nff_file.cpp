@@ -275,8 +275,8 @@ private:
 
     /// `f r g b Kd Ks Shine T ior` (docs/nff.md, the mapping). A fill whose eight numbers are
     /// those of an earlier one is that material again: SPD's lattice writes one of five fills
-    /// before each of its 8,281 objects, and a material per line made the reading four times
-    /// slower (each a MaterialDescription of 416 bytes, their array grown into fresh memory).
+    /// before each of its 8,281 objects, and a material per line (416 bytes each, an array
+    /// grown into fresh memory) costs its reading four times what the objects do.
     void read_fill(const Token& code) {
         const Located<double> r = number("fill colour (red)"), g = number("fill colour (green)"),
                               b = number("fill colour (blue)");
