@@ -21,7 +21,7 @@
 // 128 KiB (a threshold glibc then moves as blocks are freed) a block is mapped afresh, and
 // when more than 128 KiB lies free at the top of a heap the heap is cut back (a TLB shootdown
 // on every core) and the next block faults its pages in again. Writing a PNG,
-// each band of rows goes through OpenColorIO with a 64 KiB scratch buffer of its own: on some
+// each band of rows goes through the display transform with a 64 KiB scratch buffer of its own: on some
 // images (SPD `tetra -s 5`, 512x512) a thread's heap was cut back and regrown for every band,
 // and the write took 24 ms instead of 7. So keep_freed_memory fixes both thresholds: blocks
 // under 8 MiB always come from the heaps, and up to 64 MiB freed at a heap's top is kept.

@@ -553,7 +553,7 @@ int main(int argc, char** argv) {
     render_cmd
         ->add_option("-o,--output", render_args.output,
                      "Output image: .exr is linear float (scene-referred); .png/.jpg/.tif go through the "
-                     "OpenColorIO display transform")
+                     "display transform (--display, --view, --ocio-config)")
         ->capture_default_str()
         ->check(not_empty);
     render_cmd->add_option("-t,--threads", render_args.threads, "Worker threads (default: all cores)")

@@ -108,7 +108,7 @@ def write_image(
     view: str = "",
 ) -> None:
     """Write an H x W x 3 linear image as `whitted render` does: .exr linear, .png/.jpg/.tif through
-    the OpenColorIO display transform."""
+    the display transform (the built-in config's, or the OpenColorIO config's)."""
     ...
 
 def to_povray(scene: Scene) -> str:

@@ -353,7 +353,7 @@ PYBIND11_MODULE(whitted, m) {
         py::arg("image"), py::arg("path"), py::arg("half") = false, py::arg("exr_compression") = "",
         py::arg("bit_depth") = 0, py::arg("ocio_config") = "", py::arg("display") = "", py::arg("view") = "",
         "Write an H x W x 3 linear image as `whitted render` does: .exr linear, .png/.jpg/.tif through the "
-        "OpenColorIO display transform.");
+        "display transform (the built-in config's, or the OpenColorIO config's).");
 
     m.def(
         "to_povray", [](const api::Scene& scene) { return take(api::to_povray(scene)); }, py::arg("scene"),

@@ -88,6 +88,12 @@ assert np.isfinite(image).all() and image.max() > 0.05, image.max()
 whitted.write_image(image, "shadows.png")
 with open("shadows.png", "rb") as f:
     assert f.read(8) == b"\x89PNG\r\n\x1a\n"
+# A config file goes through OpenColorIO, the plug-in beside the library (the built-in config
+# needs none): the built-in config written out, then used by name.
+whitted.write_colour_config("builtin.ocio")
+whitted.write_image(image, "shadows-ocio.png", ocio_config="builtin.ocio", display="Display P3")
+with open("shadows-ocio.png", "rb") as f:
+    assert f.read(8) == b"\x89PNG\r\n\x1a\n"
 # `check` runs in the OpenImageIO plug-in: a small copy of a lecture example against POV-Ray.
 with open(scene_file.replace("02-shadows", "01-lambertian-sphere")) as f:
     text = f.read()
@@ -102,7 +108,7 @@ with open("/proc/self/maps") as f:
 libs = os.path.join(site, "whitted.libs")
 assert mapped and all(os.path.dirname(p) == libs for p in mapped), mapped
 assert any(p.endswith("libwhitted_oiio.so") for p in mapped), mapped
-# The PNG went through OpenColorIO's sRGB display transform, the plug-in beside the library.
+# The config file's PNG went through OpenColorIO's display transform, the plug-in beside the library.
 assert any(p.endswith("libwhitted_ocio.so") for p in mapped), mapped
 print("rendered", image.shape, "max", image.max(), "; check:", result.verdict, "; loaded", sorted(mapped))
 EOF

@@ -351,7 +351,7 @@ struct WriteOptions {
 };
 
 /// Writes the image as `whitted render` does: .exr linear (with its layers); .png/.jpg/.tif
-/// through the OpenColorIO display transform (these three load the OpenImageIO plug-in). The
+/// through the display transform (the built-in config's; a config file's loads OpenColorIO). The
 /// file appears complete or not at all.
 WHITTED_API Expected<void> write_image(const Image& image, const std::string& path, const WriteOptions& options = {});
 

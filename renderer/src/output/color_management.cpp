@@ -1,14 +1,14 @@
 // SPDX-License-Identifier: MIT
-// DisplayTransform's side in the program: OpenColorIO itself is reached through the plug-in
+// DisplayTransform's side in the program: the built-in config is computed here
+// (builtin_config.cpp); OpenColorIO, for a config file, is reached through the plug-in
 // lib/libwhitted_ocio.so (ocio_display.cpp; ocio_plugin.h says why).
 #include "output/color_management.h"
 
 #include "core/plugin.h"
+#include "output/builtin_config.h"
 #include "output/ocio_plugin.h"
 
 #include <cstdlib>
-#include <map>
-#include <mutex>
 #include <stdexcept>
 #include <utility>
 
@@ -20,7 +20,8 @@ namespace {
 void* ocio_symbol(const char* name) {
     try {
         return plugin_symbol("libwhitted_ocio.so", name,
-                             "OpenColorIO's display transform, needed to write .png, .jpg and .tif files");
+                             "OpenColorIO, needed to read a colour config file (--ocio-config or $OCIO) and to "
+                             "write or list the built-in config");
     } catch (const std::runtime_error& e) {
         throw std::invalid_argument(e.what());
     }
@@ -32,37 +33,11 @@ bool uses_builtin_config(const std::string& config_path) {
     return config_path.empty() && (!env || !*env);
 }
 
-/// What the plug-in made of the built-in config for a (display, view) request. That config
-/// cannot change while the process runs, and a render makes its display transform twice (when
-/// it checks its options, before any work, and again when it writes), a Python session once
-/// per image: building it again cost about 0.4 ms of CPU each time (docs/performance.md,
-/// "Start-up"). A config file is read again every time: it may have changed. Never destroyed:
-/// its processors belong to OpenColorIO, whose own statics may be gone at exit.
-struct BuiltinTransforms {
-    std::mutex mutex;
-    std::map<std::pair<std::string, std::string>, DisplayTransformParts> made;
-};
-
-BuiltinTransforms& builtin_transforms() {
-    static auto* transforms = new BuiltinTransforms;
-    return *transforms;
-}
-
 DisplayTransformParts make_parts(const std::string& config_path, const std::string& display, const std::string& view) {
-    const bool builtin = uses_builtin_config(config_path);
-    if (builtin) {
-        BuiltinTransforms& transforms = builtin_transforms();
-        const std::lock_guard lock(transforms.mutex);
-        if (const auto it = transforms.made.find({display, view}); it != transforms.made.end()) return it->second;
-    }
+    if (uses_builtin_config(config_path)) return builtin_display_transform(display, view);
     DisplayTransformParts parts;
     reinterpret_cast<MakeDisplayTransformFunction>(ocio_symbol("whitted_ocio_display_transform"))(config_path, display,
                                                                                                   view, parts);
-    if (builtin) {
-        BuiltinTransforms& transforms = builtin_transforms();
-        const std::lock_guard lock(transforms.mutex);
-        transforms.made.emplace(std::make_pair(display, view), parts);
-    }
     return parts;
 }
 

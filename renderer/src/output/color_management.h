@@ -21,18 +21,35 @@ struct DisplayEncoding {
     std::string description() const;
 };
 
-/// Turns scene-linear RGB into display-referred RGB through OpenColorIO, which is loaded (as the
-/// plug-in lib/libwhitted_ocio.so, output/ocio_plugin.h) the first time one is made.
+/// Display-linear light → display code by `transfer` (the exact formulas: IEC 61966-2-1 for
+/// sRGB, pure powers for the gammas; linear and unknown leave the value as it is).
+double encode(DisplayEncoding::Transfer transfer, double linear);
+/// The inverse of encode().
+double decode(DisplayEncoding::Transfer transfer, double code);
+
+/// What makes a DisplayTransform: from the built-in config (builtin_config.h) or from
+/// OpenColorIO (the plug-in, ocio_plugin.h).
+struct DisplayTransformParts {
+    /// In place, packed RGB float pixels; large buffers on all cores.
+    std::function<void(float* rgb, size_t pixel_count)> apply;
+    std::string source, config_name, display, view, colorspace;
+    DisplayEncoding encoding;
+};
+
+/// Turns scene-linear RGB into display-referred RGB.
 ///
-/// The config comes from `config_path` when given, else from $OCIO, else from the built-in
+/// The config comes from `config_path` when given, else from $OCIO, else it is the built-in
 /// config (OCIO 2.1 ships none; docs/colour.md describes it): scene_linear = linear Rec.709,
-/// displays sRGB, Gamma 2.2, BT.1886 and Display P3, each with the views Standard and Raw.
+/// displays sRGB, Gamma 2.2, BT.1886 and Display P3, each with the views Standard and Raw. The
+/// built-in config's displays are closed-form and computed here exactly (builtin_config.h); a
+/// config file goes through OpenColorIO, loaded (as the plug-in lib/libwhitted_ocio.so,
+/// output/ocio_plugin.h) the first time one is made.
 class DisplayTransform {
 public:
     /// Empty `display`/`view` mean the config's defaults. Throws std::invalid_argument (a usage
     /// error) for an unreadable config or unknown names (the message lists the known ones), and
     /// std::runtime_error when OCIO cannot build the transform; std::invalid_argument naming the
-    /// plug-in when it cannot be loaded.
+    /// plug-in when a config file is to be read and the plug-in cannot be loaded.
     DisplayTransform(const std::string& config_path, const std::string& display, const std::string& view);
     ~DisplayTransform();
 
@@ -49,7 +66,8 @@ public:
     const std::string& colorspace() const { return m_colorspace; }
     const DisplayEncoding& encoding() const { return m_encoding; }
 
-    /// The built-in config, serialised (`whitted colour --write-config`, docs and tests).
+    /// The built-in config, serialised by OpenColorIO (`whitted colour --write-config`, docs and
+    /// tests).
     static std::string builtin_config_text();
     /// Every display and view of a config (chosen as the constructor does) with the colour
     /// space each view writes and what that means: `whitted colour --list`.

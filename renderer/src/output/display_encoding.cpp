@@ -3,7 +3,39 @@
 // both describe encodings.
 #include "output/color_management.h"
 
+#include <cmath>
+
 namespace whitted {
+
+double encode(DisplayEncoding::Transfer transfer, double linear) {
+    switch (transfer) {
+        case DisplayEncoding::Transfer::srgb:
+            return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1 / 2.4) - 0.055;
+        case DisplayEncoding::Transfer::gamma22:
+            return std::pow(linear, 1 / 2.2);
+        case DisplayEncoding::Transfer::gamma24:
+            return std::pow(linear, 1 / 2.4);
+        case DisplayEncoding::Transfer::linear:
+        case DisplayEncoding::Transfer::unknown:
+            break;
+    }
+    return linear;
+}
+
+double decode(DisplayEncoding::Transfer transfer, double code) {
+    switch (transfer) {
+        case DisplayEncoding::Transfer::srgb:
+            return code <= 0.04045 ? code / 12.92 : std::pow((code + 0.055) / 1.055, 2.4);
+        case DisplayEncoding::Transfer::gamma22:
+            return std::pow(code, 2.2);
+        case DisplayEncoding::Transfer::gamma24:
+            return std::pow(code, 2.4);
+        case DisplayEncoding::Transfer::linear:
+        case DisplayEncoding::Transfer::unknown:
+            break;
+    }
+    return code;
+}
 
 std::string DisplayEncoding::description() const {
     std::string text;

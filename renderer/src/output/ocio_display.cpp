@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The OpenColorIO side of DisplayTransform: the plug-in lib/libwhitted_ocio.so
 // (output/ocio_plugin.h says why it is one).
+#include "output/builtin_config.h"
 #include "output/chromaticities.h"
 #include "output/color_management.h"
 #include "output/ocio_plugin.h"
@@ -22,8 +23,6 @@ namespace OCIO = OCIO_NAMESPACE;
 
 namespace whitted {
 namespace {
-
-constexpr const char* scene_linear_name = "Linear Rec.709 (sRGB)";
 
 /// A display colour space of the built-in config: `decode` (display code → display-linear
 /// light, the colour space's "to reference" direction) and, for other primaries than Rec.709,
@@ -67,57 +66,54 @@ OCIO::ConstTransformRcPtr power_curve(double gamma) {
     return curve;
 }
 
+/// The built-in config (builtin_config.h) as an OpenColorIO config.
 OCIO::ConstConfigRcPtr make_builtin_config() {
     OCIO::ConfigRcPtr config = OCIO::Config::Create();
-    config->setName("whitted-builtin");
-    config->setDescription(
-        "Whitted's built-in config: linear Rec.709 scene values; sRGB, Gamma 2.2, BT.1886 and Display P3 "
-        "displays, each with a Standard view (the display's encoding) and a Raw view (no conversion).");
+    config->setName(builtin_config_name);
+    config->setDescription(builtin_config_description);
 
     OCIO::ColorSpaceRcPtr linear = OCIO::ColorSpace::Create();
-    linear->setName(scene_linear_name);
+    linear->setName(builtin_scene_linear);
     linear->setFamily("Scene-linear");
     linear->setDescription("Scene-referred linear light with Rec.709 / sRGB primaries, D65: what Whitted renders.");
     linear->setEncoding("scene-linear");
     config->addColorSpace(linear);
 
-    config->addColorSpace(display_space("sRGB - Display",
-                                        "The sRGB piecewise curve (IEC 61966-2-1) on Rec.709 primaries, D65.",
-                                        srgb_curve(), nullptr));
-    config->addColorSpace(display_space("Gamma 2.2 Rec.709 - Display",
-                                        "A pure 2.2 power law on Rec.709 primaries, D65 (the Cornell course's "
-                                        "reference images).",
-                                        power_curve(2.2), nullptr));
-    config->addColorSpace(display_space("BT.1886 Rec.709 - Display",
-                                        "Rec.709 video as an ITU-R BT.1886 display shows it (black 0, white 1: a 2.4 "
-                                        "power law) on Rec.709 primaries, D65.",
-                                        power_curve(2.4), nullptr));
-    config->addColorSpace(display_space("Display P3 - Display",
-                                        "Apple's Display P3: the sRGB curve on P3-D65 (SMPTE EG 432-1) primaries.",
-                                        srgb_curve(), &display_p3_chromaticities));
+    for (const BuiltinDisplay& display : builtin_displays) {
+        const OCIO::ConstTransformRcPtr curve = display.transfer == DisplayEncoding::Transfer::srgb ? srgb_curve()
+                                                : display.transfer == DisplayEncoding::Transfer::gamma22
+                                                    ? power_curve(2.2)
+                                                    : power_curve(2.4);
+        config->addColorSpace(display_space(
+            display.colorspace, display.description, curve,
+            display.primaries == DisplayEncoding::Primaries::display_p3 ? &display_p3_chromaticities : nullptr));
+    }
 
     OCIO::ColorSpaceRcPtr raw = OCIO::ColorSpace::Create();
-    raw->setName("Raw");
+    raw->setName(builtin_raw);
     raw->setFamily("Utility");
-    raw->setDescription("No conversion: the linear Rec.709 values, clipped to the file's range.");
+    raw->setDescription(builtin_raw_description);
     raw->setIsData(true);
     config->addColorSpace(raw);
 
-    config->setRole(OCIO::ROLE_SCENE_LINEAR, scene_linear_name);
-    config->setRole(OCIO::ROLE_DEFAULT, scene_linear_name);
-    config->setRole(OCIO::ROLE_REFERENCE, scene_linear_name);
-    config->setRole(OCIO::ROLE_DATA, "Raw");
-    config->setRole("color_picking", "sRGB - Display");
-    const std::pair<const char*, const char*> displays[] = {{"sRGB", "sRGB - Display"},
-                                                            {"Gamma 2.2", "Gamma 2.2 Rec.709 - Display"},
-                                                            {"BT.1886", "BT.1886 Rec.709 - Display"},
-                                                            {"Display P3", "Display P3 - Display"}};
-    for (const auto& [display, space] : displays) {
-        config->addDisplayView(display, "Standard", space, "");
-        config->addDisplayView(display, "Raw", "Raw", "");
+    config->setRole(OCIO::ROLE_SCENE_LINEAR, builtin_scene_linear);
+    config->setRole(OCIO::ROLE_DEFAULT, builtin_scene_linear);
+    config->setRole(OCIO::ROLE_REFERENCE, builtin_scene_linear);
+    config->setRole(OCIO::ROLE_DATA, builtin_raw);
+    config->setRole("color_picking", builtin_displays[0].colorspace);
+    std::string displays, views;
+    for (const BuiltinDisplay& display : builtin_displays) {
+        config->addDisplayView(display.name, builtin_views[0], display.colorspace, "");
+        config->addDisplayView(display.name, builtin_views[1], builtin_raw, "");
+        if (!displays.empty()) displays += ", ";
+        displays += display.name;
     }
-    config->setActiveDisplays("sRGB, Gamma 2.2, BT.1886, Display P3");
-    config->setActiveViews("Standard, Raw");
+    for (const char* view : builtin_views) {
+        if (!views.empty()) views += ", ";
+        views += view;
+    }
+    config->setActiveDisplays(displays.c_str());
+    config->setActiveViews(views.c_str());
     config->validate();
     return config;
 }
@@ -245,38 +241,6 @@ OCIO::ConstCPUProcessorRcPtr make_processor(const OCIO::ConstConfigRcPtr& config
     } catch (const OCIO::Exception& e) {
         throw std::runtime_error(std::string("OpenColorIO cannot build the display transform: ") + e.what());
     }
-}
-
-/// Display-linear light → display code, for each transfer function a file can declare.
-double encode(DisplayEncoding::Transfer transfer, double linear) {
-    switch (transfer) {
-        case DisplayEncoding::Transfer::srgb:
-            return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1 / 2.4) - 0.055;
-        case DisplayEncoding::Transfer::gamma22:
-            return std::pow(linear, 1 / 2.2);
-        case DisplayEncoding::Transfer::gamma24:
-            return std::pow(linear, 1 / 2.4);
-        case DisplayEncoding::Transfer::linear:
-        case DisplayEncoding::Transfer::unknown:
-            break;
-    }
-    return linear;
-}
-
-/// The inverse of encode().
-double decode(DisplayEncoding::Transfer transfer, double code) {
-    switch (transfer) {
-        case DisplayEncoding::Transfer::srgb:
-            return code <= 0.04045 ? code / 12.92 : std::pow((code + 0.055) / 1.055, 2.4);
-        case DisplayEncoding::Transfer::gamma22:
-            return std::pow(code, 2.2);
-        case DisplayEncoding::Transfer::gamma24:
-            return std::pow(code, 2.4);
-        case DisplayEncoding::Transfer::linear:
-        case DisplayEncoding::Transfer::unknown:
-            break;
-    }
-    return code;
 }
 
 /// Runs the transform on greys and on each primary and recognises the result: the transfer

@@ -4,27 +4,18 @@
 #include "output/color_management.h"
 #include "output/format_plugins.h"
 
-#include <cstddef>
-#include <functional>
 #include <string>
 
 /// OpenColorIO (with yaml-cpp, pystring and Imath, which it brings) is the
 /// dearest library the program would load at start-up, about as dear as Embree and TBB together
-/// (docs/performance.md, "Start-up"), and an EXR render, `whitted --version` or a scene check
-/// need none of it. So DisplayTransform's OpenColorIO side is a plug-in, lib/libwhitted_ocio.so,
-/// loaded the first time a display transform is made (core/plugin.h says where it is
-/// looked for). Like the writers' plug-ins (format_plugins.h) it exports C functions of C++
+/// (docs/performance.md, "Start-up"), and an EXR render, `whitted --version`, a scene check and
+/// a file written with the built-in config (builtin_config.h) need none of it. So
+/// DisplayTransform's OpenColorIO side is a plug-in, lib/libwhitted_ocio.so, loaded the first
+/// time a config file is read or the built-in config is written out or listed (core/plugin.h
+/// says where it is looked for). Like the writers' plug-ins (format_plugins.h) it exports C functions of C++
 /// signatures: it is built with the program by the same compiler, so the types and exceptions
 /// cross as they are.
 namespace whitted {
-
-/// What the plug-in makes of a config, display and view: DisplayTransform's state.
-struct DisplayTransformParts {
-    /// In place, packed RGB float pixels; large buffers on all cores.
-    std::function<void(float* rgb, size_t pixel_count)> apply;
-    std::string source, config_name, display, view, colorspace;
-    DisplayEncoding encoding;
-};
 
 /// whitted_ocio_display_transform: throws as DisplayTransform's constructor documents.
 using MakeDisplayTransformFunction = void (*)(const std::string& config_path, const std::string& display,
