@@ -12,9 +12,9 @@
 /// a file written with the built-in config (builtin_config.h) need none of it. So
 /// DisplayTransform's OpenColorIO side is a plug-in, lib/libwhitted_ocio.so, loaded the first
 /// time a config file is read or the built-in config is written out or listed (core/plugin.h
-/// says where it is looked for). Like the writers' plug-ins (format_plugins.h) it exports C functions of C++
-/// signatures: it is built with the program by the same compiler, so the types and exceptions
-/// cross as they are.
+/// says where it is looked for). Like the writers' plug-ins (format_plugins.h) it exports C
+/// functions of C++ signatures: it is built with the program by the same compiler, so the types
+/// and exceptions cross as they are.
 namespace whitted {
 
 /// whitted_ocio_display_transform: throws as DisplayTransform's constructor documents.
