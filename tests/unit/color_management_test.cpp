@@ -83,6 +83,14 @@ TEST_F(BuiltinConfig, StandardViewsAreTheFormulasRoundedOnce) {
                 ADD_FAILURE() << display << " at " << values[i] << ": " << rgb[i] << " against "
                               << float(formula(double(values[i])));
         EXPECT_EQ(differ, 0u) << display << ", of " << values.size() << " values";
+        // Runs of equal pixels (a background) between others: each pixel its own formula's.
+        std::vector<float> runs;
+        for (const float v : {0.25f, 0.25f, 0.25f, 0.002f, 0.25f, 0.25f, 0.7f, 0.7f})
+            runs.insert(runs.end(), {v, v * 0.5f, 0.001f});
+        const std::vector<float> linear_runs = runs;
+        DisplayTransform("", display, "Standard").apply(runs.data(), runs.size() / 3);
+        for (size_t i = 0; i < runs.size(); ++i)
+            EXPECT_EQ(runs[i], float(formula(double(linear_runs[i])))) << display << " run value " << i;
         std::vector<float> dark = {0.0f, -0.0f, -1e-3f, -1.0f, NAN, -INFINITY};
         DisplayTransform("", display, "Standard").apply(dark.data(), 2);
         for (const float v : dark) EXPECT_EQ(v, 0.0f) << display;
