@@ -15,10 +15,6 @@
 namespace whitted {
 namespace {
 
-std::string join_names(const std::string& first, const std::string& second) {
-    return first.empty() ? second : first + ", " + second;
-}
-
 /// Applies `transform` to every pixel (its three floats, in place): a large buffer in chunks on
 /// all cores, a small one on the calling thread (a PNG's rows come eight at a time). A pixel
 /// equal to the one before it (a background, a flat wall) takes that one's result: the
@@ -52,21 +48,16 @@ DisplayTransformParts builtin_display_transform(const std::string& display, cons
     parts.source = "built-in";
     parts.config_name = builtin_config_name;
     const BuiltinDisplay* chosen = display.empty() ? &builtin_displays[0] : nullptr;
-    std::string displays;
-    for (const BuiltinDisplay& d : builtin_displays) {
+    for (const BuiltinDisplay& d : builtin_displays)
         if (d.name == display) chosen = &d;
-        displays = join_names(displays, d.name);
-    }
     if (!chosen)
         throw std::invalid_argument("OpenColorIO display '" + display +
-                                    "' is not in the config (built-in); displays: " + displays);
+                                    "' is not in the config (built-in); displays: " + builtin_display_list());
     parts.display = chosen->name;
     parts.view = view.empty() ? builtin_views[0] : view;
-    std::string views;
-    for (const char* v : builtin_views) views = join_names(views, v);
     if (parts.view != builtin_views[0] && parts.view != builtin_views[1])
         throw std::invalid_argument("OpenColorIO view '" + parts.view + "' is not a view of display '" + parts.display +
-                                    "'; views: " + views);
+                                    "'; views: " + builtin_view_list());
 
     if (parts.view == builtin_views[1]) {
         // Raw: a data space, the scene values as they are (the file clips them).

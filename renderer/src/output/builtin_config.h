@@ -49,6 +49,26 @@ inline constexpr const char* builtin_raw = "Raw";
 inline constexpr const char* builtin_raw_description =
     "No conversion: the linear Rec.709 values, clipped to the file's range.";
 
+/// The displays' names as the config's active list writes them: "sRGB, Gamma 2.2, ...".
+inline std::string builtin_display_list() {
+    std::string list;
+    for (const BuiltinDisplay& display : builtin_displays) {
+        if (!list.empty()) list += ", ";
+        list += display.name;
+    }
+    return list;
+}
+
+/// The views' names the same way: "Standard, Raw".
+inline std::string builtin_view_list() {
+    std::string list;
+    for (const char* view : builtin_views) {
+        if (!list.empty()) list += ", ";
+        list += view;
+    }
+    return list;
+}
+
 /// The display transform of the built-in config for `display` and `view` (empty: the
 /// defaults), computed in double and rounded to float once per value. Throws
 /// std::invalid_argument for an unknown name, listing the known ones (the words OpenColorIO's

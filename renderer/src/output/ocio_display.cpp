@@ -101,19 +101,12 @@ OCIO::ConstConfigRcPtr make_builtin_config() {
     config->setRole(OCIO::ROLE_REFERENCE, builtin_scene_linear);
     config->setRole(OCIO::ROLE_DATA, builtin_raw);
     config->setRole("color_picking", builtin_displays[0].colorspace);
-    std::string displays, views;
     for (const BuiltinDisplay& display : builtin_displays) {
         config->addDisplayView(display.name, builtin_views[0], display.colorspace, "");
         config->addDisplayView(display.name, builtin_views[1], builtin_raw, "");
-        if (!displays.empty()) displays += ", ";
-        displays += display.name;
     }
-    for (const char* view : builtin_views) {
-        if (!views.empty()) views += ", ";
-        views += view;
-    }
-    config->setActiveDisplays(displays.c_str());
-    config->setActiveViews(views.c_str());
+    config->setActiveDisplays(builtin_display_list().c_str());
+    config->setActiveViews(builtin_view_list().c_str());
     config->validate();
     return config;
 }
