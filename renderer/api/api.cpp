@@ -440,7 +440,7 @@ Expected<AcceleratorInfo> prepare(const Scene& scene, int threads) {
     return guarded<AcceleratorInfo>("building the BVH of " + scene.path(), [&]() -> Expected<AcceleratorInfo> {
         const Accelerator& accelerator = impl_of(scene).accelerator(threads);
         return AcceleratorInfo{accelerator.embree_bytes(), accelerator.peak_embree_bytes(), accelerator.isa(),
-                               accelerator.lane_width()};
+                               accelerator.lane_width(), accelerator.has_bvh()};
     });
 }
 

@@ -156,6 +156,15 @@ void install_signal_handlers() {
     }
 }
 
+/// --stats' account of what traces the rays: Embree's BVH, or each ray testing the scene's few
+/// shapes (api::AcceleratorInfo::has_bvh).
+std::string bvh_summary(const api::AcceleratorInfo& accelerator) {
+    if (!accelerator.has_bvh) return "no BVH: each ray tests the scene's few shapes";
+    return fmt::format("BVH {:.1f} MB ({:.1f} MB while building); Embree {}, {}-wide packets",
+                       double(accelerator.bytes) / 1e6, double(accelerator.peak_bytes) / 1e6,
+                       accelerator.isa.empty() ? "(its choice)" : accelerator.isa, accelerator.lane_width);
+}
+
 std::string format_duration(double seconds) {
     if (seconds < 60) return fmt::format("{:.1f}s", seconds);
     return fmt::format("{}m{:02d}s", int(seconds / 60), int(seconds) % 60);
@@ -382,11 +391,10 @@ int run_render(const RenderArguments& args) {
             "whitted: stages: read (parse, validate, load meshes) %.3fs, build BVH %.3fs, render %.3fs, write "
             "%.3fs; "
             "%zu triangles, %zu spheres, %zu boxes, %zu planes, %zu lights, %zu instances (%zu triangles seen); "
-            "BVH %.1f MB (%.1f MB while building); Embree %s, %d-wide packets\n",
+            "%s\n",
             scene.read_seconds(), build_seconds, result.stats.seconds, write_seconds, counts.triangles, counts.spheres,
             counts.boxes, counts.planes, counts.lights, counts.instances, counts.instanced_triangles,
-            double(accelerator->bytes) / 1e6, double(accelerator->peak_bytes) / 1e6,
-            accelerator->isa.empty() ? "(its choice)" : accelerator->isa.c_str(), accelerator->lane_width);
+            bvh_summary(*accelerator).c_str());
     if (!args.quiet)
         std::fprintf(
             stderr,

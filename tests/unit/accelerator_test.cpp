@@ -380,7 +380,9 @@ TEST(Accelerator, ALongConeCutIntoPartsGivesTheWholeConesHit) {
         "     material: {kd: 0.5}}",
     }));
     ASSERT_EQ(scene.cones.size(), 2u);
-    const Accelerator accelerator(scene, 1);
+    // Cut into parts for Embree's BVH; whole where two cones are tested on every ray (BvhChoice).
+    const Accelerator accelerator(scene, 1, "", BvhChoice::always), without_bvh(scene, 1, "");
+    ASSERT_FALSE(without_bvh.has_bvh());
     std::mt19937_64 random(38);
     std::uniform_real_distribution<double> across(-3.5, 3.5), jitter(-0.05, 0.05);
     int hits = 0;
@@ -402,17 +404,133 @@ TEST(Accelerator, ALongConeCutIntoPartsGivesTheWholeConesHit) {
             if (intersect_cone(cone, ray, ray.t_min, nearest, hit))
                 nearest = hit.t, normal = normalize(hit.normal), expected = true;
         }
-        SurfaceHit found;
-        ASSERT_EQ(accelerator.intersect(ray, found), expected) << "ray " << k;
-        EXPECT_EQ(accelerator.occluded(ray), expected) << "ray " << k;
-        if (!expected) continue;
-        ++hits;
-        EXPECT_EQ(found.t, nearest) << "ray " << k;
-        EXPECT_EQ(found.normal.x, normal.x) << "ray " << k;
-        EXPECT_EQ(found.normal.y, normal.y) << "ray " << k;
-        EXPECT_EQ(found.normal.z, normal.z) << "ray " << k;
+        for (const Accelerator* tested : {&accelerator, &without_bvh}) {
+            SurfaceHit found;
+            ASSERT_EQ(tested->intersect(ray, found), expected) << "ray " << k;
+            EXPECT_EQ(tested->occluded(ray), expected) << "ray " << k;
+            if (!expected) continue;
+            hits += tested == &accelerator;
+            EXPECT_EQ(found.t, nearest) << "ray " << k;
+            EXPECT_EQ(found.normal.x, normal.x) << "ray " << k;
+            EXPECT_EQ(found.normal.y, normal.y) << "ray " << k;
+            EXPECT_EQ(found.normal.z, normal.z) << "ray " << k;
+        }
     }
     EXPECT_GT(hits, 5000);
+}
+
+// A scene of a few spheres, boxes and cones has no BVH (BvhChoice): each ray tests them all,
+// with the decisions Embree's callbacks make. Its answers must be the BVH's, bit for bit, for
+// random scenes built to tie: spheres repeated in one place with another material, boxes whose
+// faces lie in one plane, a cylinder inside a sphere, a plane through a box's face, turned and
+// scaled shapes (which move rays from afar), under both rules (render.intersection), for random
+// rays alone and in packets.
+TEST(Accelerator, AFewShapesWithoutBvhGiveTheBvhsAnswers) {
+    std::mt19937_64 random(20261207);
+    std::uniform_real_distribution<double> place(-2, 2), size(0.2, 1.2), chance(0, 1);
+    const auto number = [](double value) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.6g", value);
+        return std::string(text);
+    };
+    const auto point = [&](double x, double y, double z) {
+        return "[" + number(x) + ", " + number(y) + ", " + number(z) + "]";
+    };
+    int scenes_with_ties = 0, hits_seen = 0, blocked_seen = 0, missed_seen = 0;
+    for (int s = 0; s < 24; ++s) {
+        std::vector<std::string> lines{
+            "camera: {eye: [0, 1, 7], look_at: [0, 0, 0]}",
+            "image: {width: 8, height: 8}",
+            std::string("render: {intersection: ") + (s % 2 ? "povray" : "exact") + "}",
+            "materials:",
+            "  a: {kd: 0.5}",
+            "  b: {kd: 0.7, kt: 0.5, ior: 1.3}",
+            "objects:",
+        };
+        const double cx = place(random), cy = place(random), cz = place(random), r = size(random);
+        const std::string sphere = "center: " + point(cx, cy, cz) + ", radius: " + number(r);
+        lines.push_back("  - {type: sphere, " + sphere + ", material: a}");
+        lines.push_back("  - {type: sphere, " + sphere + ", material: b}");  // the same sphere again
+        const double bx = place(random), by = place(random), bz = place(random), w = size(random);
+        lines.push_back("  - {type: box, min: " + point(bx, by, bz) + ", max: " + point(bx + w, by + w, bz + w) +
+                        ", material: a}");
+        // Beside it, one face in the first box's plane z = bz + w.
+        lines.push_back("  - {type: box, min: " + point(bx + w, by, bz) +
+                        ", max: " + point(bx + 2 * w, by + w / 2, bz + w) + ", material: b}");
+        lines.push_back("  - {type: cylinder, base: " + point(cx - r / 2, cy, cz) + ", cap: " +
+                        point(cx + r / 2, cy + r / 3, cz) + ", radius: " + number(r / 4) + ", material: b}");
+        lines.push_back("  - {type: cone, base: " + point(place(random), place(random), place(random)) +
+                        ", base_radius: 0.4, cap: " + point(place(random), place(random), place(random)) +
+                        ", cap_radius: 0.1, material: a}");
+        lines.push_back(
+            "  - {type: sphere, center: [0.5, -0.5, 0.2], radius: 0.6, material: a, transform: "
+            "[{scale: [1, 2, 0.5]}, {rotate: {axis: [1, 1, 0], angle: " +
+            number(360 * chance(random)) + "}}]}");
+        lines.push_back("  - {type: plane, point: " + point(0, by, 0) + ", normal: [0, 1, 0], material: b}");
+        const Scene scene = test::scene_from(test::join_lines(lines));
+        const Accelerator with_bvh(scene, 1, "", BvhChoice::always);
+        const Accelerator without(scene, 1, "");
+        ASSERT_TRUE(with_bvh.has_bvh());
+        ASSERT_FALSE(without.has_bvh()) << "a scene of 7 shapes and a plane";
+        bool tie_here = false;
+        constexpr int lanes = Accelerator::packet_size;
+        for (int packet = 0; packet < 150; ++packet) {
+            Ray rays[lanes];
+            bool active[lanes];
+            for (int i = 0; i < lanes; ++i) {
+                rays[i] = random_ray(random);
+                // A quarter of the rays aimed at the shared face's plane, the spheres' centre,
+                // or along the plane; a few from far away.
+                const double pick = chance(random);
+                Vec3 target = rays[i].origin + rays[i].direction;
+                if (pick < 0.1)
+                    target = {bx + w * chance(random), by + w * chance(random) / 2, bz + w};
+                else if (pick < 0.2)
+                    target = {cx, cy, cz};
+                else if (pick < 0.25)
+                    target = {place(random), by, place(random)};
+                if (pick < 0.25) rays[i].direction = normalize(target - rays[i].origin);
+                if (chance(random) < 0.05) rays[i].origin = rays[i].origin + rays[i].direction * -1e6;
+                active[i] = chance(random) < 0.85;
+            }
+            SurfaceHit hits[2][lanes];
+            bool found[2][lanes] = {}, blocked[2][lanes] = {};
+            with_bvh.intersect_packet(rays, active, lanes, hits[0], found[0]);
+            without.intersect_packet(rays, active, lanes, hits[1], found[1]);
+            with_bvh.occluded_packet(rays, active, lanes, blocked[0]);
+            without.occluded_packet(rays, active, lanes, blocked[1]);
+            for (int i = 0; i < lanes; ++i) {
+                if (!active[i]) continue;
+                SurfaceHit alone;
+                const bool alone_found = without.intersect(rays[i], alone);
+                const std::string where =
+                    "scene " + std::to_string(s) + " packet " + std::to_string(packet) + " lane " + std::to_string(i);
+                ASSERT_EQ(found[1][i], found[0][i]) << where;
+                ASSERT_EQ(alone_found, found[0][i]) << where;
+                EXPECT_EQ(blocked[1][i], blocked[0][i]) << where;
+                EXPECT_EQ(without.occluded(rays[i]), blocked[0][i]) << where;
+                ++(found[0][i] ? hits_seen : missed_seen);
+                blocked_seen += blocked[0][i];
+                if (!found[0][i]) continue;
+                for (const SurfaceHit* hit : {&hits[1][i], &alone}) {
+                    EXPECT_EQ(hit->t, hits[0][i].t) << where;
+                    EXPECT_EQ(hit->material, hits[0][i].material) << where;
+                    EXPECT_EQ(hit->object, hits[0][i].object) << where;
+                    EXPECT_EQ(hit->normal.x, hits[0][i].normal.x) << where;
+                    EXPECT_EQ(hit->normal.y, hits[0][i].normal.y) << where;
+                    EXPECT_EQ(hit->normal.z, hits[0][i].normal.z) << where;
+                    EXPECT_EQ(hit->geometric_normal.z, hits[0][i].geometric_normal.z) << where;
+                }
+                // The two spheres are one surface: every hit on it is a tie between objects 1 and 2.
+                tie_here |= hits[0][i].object <= 2;
+            }
+        }
+        scenes_with_ties += tie_here;
+    }
+    EXPECT_GT(hits_seen, 20000);
+    EXPECT_GT(missed_seen, 5000);
+    EXPECT_GT(blocked_seen, 20000);
+    EXPECT_GT(scenes_with_ties, 20);
 }
 
 // An instance is its prototype under the transform, hit in double: a unit triangle in z = 0

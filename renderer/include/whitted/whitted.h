@@ -325,6 +325,9 @@ struct AcceleratorInfo {
     size_t peak_bytes = 0;  ///< Embree's memory at most while building it
     std::string isa;        ///< Embree's instruction set as asked ($WHITTED_EMBREE_ISA); empty: Embree's choice
     int lane_width = 1;     ///< rays per packet given to Embree
+    /// False for a scene of at most 8 spheres, boxes and cones and nothing else but planes:
+    /// each ray tests them all, with the same answers, and Embree makes no device or BVH.
+    bool has_bvh = true;
 };
 
 /// Builds the scene's BVH now with `threads` build threads (0 = all cores), as the first render

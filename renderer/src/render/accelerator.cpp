@@ -11,9 +11,12 @@ namespace whitted {
 
 Accelerator::Accelerator(const Scene& scene, int threads)
     : Accelerator(scene, threads, embree_isa_from_environment()) {}
-Accelerator::Accelerator(const Scene& scene, int threads, const std::string& isa)
+Accelerator::Accelerator(const Scene& scene, int threads, const std::string& isa, BvhChoice bvh)
     : m_impl(std::make_unique<Impl>(
-          scene, threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency())), isa)) {}
+          scene, threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency())), isa, bvh)) {}
+bool Accelerator::has_bvh() const {
+    return !m_impl->without_bvh;
+}
 int Accelerator::lane_width() const {
     return m_impl->lane_width;
 }

@@ -30,6 +30,11 @@ struct SurfaceHit {
 /// either way.
 enum class HitParts { all, without_normals };
 
+/// Whether an Accelerator makes a BVH (and an Embree device) for a scene of a few spheres,
+/// boxes and cones and nothing else but planes, or has each ray test them all, which answers
+/// every query the same and saves the device and the build.
+enum class BvhChoice { when_worthwhile, always };
+
 /// Ray queries over a Scene. Embree's BVH finds the candidates (triangles natively, spheres and
 /// boxes as user geometry intersected in double); infinite planes are tested directly. The hit
 /// that wins is recomputed in double from the double ray, so shading sees POV-Ray's precision.
@@ -40,11 +45,13 @@ public:
     explicit Accelerator(const Scene& scene, int threads = 0);
     /// `isa`: one of embree_isa_names(), or "" for the widest the CPU has. Throws
     /// std::invalid_argument when the CPU cannot run it.
-    Accelerator(const Scene& scene, int threads, const std::string& isa);
+    Accelerator(const Scene& scene, int threads, const std::string& isa, BvhChoice bvh = BvhChoice::when_worthwhile);
     ~Accelerator();
     Accelerator(const Accelerator&) = delete;
     Accelerator& operator=(const Accelerator&) = delete;
 
+    /// Whether the scene has a BVH: false where each ray tests its few shapes (BvhChoice).
+    bool has_bvh() const;
     /// Bytes Embree holds now (the BVH), and the most it held while building.
     size_t embree_bytes() const;
     size_t peak_embree_bytes() const;

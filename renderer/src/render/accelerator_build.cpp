@@ -70,10 +70,33 @@ void widen_triangles(const TriangleMesh& mesh, const Vec3& shift, double margin,
 
 }  // namespace
 
-Accelerator::Impl::Impl(const Scene& s, int threads, const std::string& instruction_set)
+Accelerator::Impl::Impl(const Scene& s, int threads, const std::string& instruction_set, BvhChoice bvh)
     : scene(s), isa(instruction_set) {
     spheres.scene = boxes.scene = cones.scene = &scene;
     check_reach();  // before Embree holds anything
+    if (bvh == BvhChoice::when_worthwhile && worth_no_bvh()) {
+        // A few spheres, boxes and cones: each ray tests them all (direct), with no Embree
+        // device. The frame still gives each ray the end Embree would have given it.
+        if (!isa.empty()) require_embree_isa(isa);  // a setting the CPU cannot run is still an error
+        without_bvh = true;
+        frame = choose_frame();
+        spheres.offset = boxes.offset = cones.offset = frame.offset;
+        // A cone is one part: the parts are for Embree's boxes, and each hit is the whole
+        // cone's either way (ConeSegment).
+        constexpr double inf = std::numeric_limits<double>::infinity();
+        for (uint32_t c = 0; c < scene.cones.size(); ++c)
+            cones.segments.push_back({c, 0.0, scene.cones[c].height, -inf, inf});
+        unsigned id = 0;
+        for (const accel::AnalyticGeometry* shapes : {&spheres, &boxes, &cones}) {
+            const size_t count = shapes == &spheres ? scene.spheres.size()
+                                 : shapes == &boxes ? scene.boxes.size()
+                                                    : cones.segments.size();
+            if (count == 0) continue;
+            direct.push_back({id, shapes, unsigned(count)});
+            record(id++, shapes->kind, 0);
+        }
+        return;
+    }
     // Embree gets the render's thread count (--threads): its setting limits the whole
     // process's TBB threads (with threads=1 the render ran at half speed), so the two must
     // agree.
@@ -128,6 +151,22 @@ Accelerator::Impl::Impl(const Scene& s, int threads, const std::string& instruct
         release();
         throw;
     }
+}
+
+/// Whether the scene is a few spheres, boxes and cones (and planes, never in the BVH) and
+/// nothing else, on few enough rays that testing every shape on each costs less than Embree
+/// would: loading it, making its device and committing the scene take 5-6 ms of a process on
+/// the machines of docs/performance.md ("Start-up"), while each ray's test of every shape
+/// costs about 2 ns more per shape than Embree's packets (2 threads). The rays are reckoned
+/// as the camera's and one shadow ray per light from each of their hits.
+bool Accelerator::Impl::worth_no_bvh() const {
+    const size_t shapes = scene.spheres.size() + scene.boxes.size() + scene.cones.size();
+    if (!scene.meshes.empty() || !scene.instances.empty() || !scene.prototypes.empty() ||
+        shapes > most_shapes_without_bvh)
+        return false;
+    const double rays =
+        double(scene.width) * scene.height * scene.samples * scene.samples * (1.0 + double(scene.lights.size()));
+    return double(shapes) * rays <= most_tests_without_bvh;
 }
 
 /// A BVH is built once per triangle and traversed once per ray. HIGH quality took 2.0 s to

@@ -134,79 +134,90 @@ void analytic_bounds(const RTCBoundsFunctionArguments* args) {
     args->bounds_o->upper_z = std::nextafter(float(hi.z), INFINITY);
 }
 
+bool consider_analytic(const AnalyticGeometry& geometry, unsigned part, QueryContext& context, unsigned id,
+                       float& tfar) {
+    // A part of a cone (ConeSegment) reports the cone itself, and only the hit that is its own.
+    const ConeSegment* segment = geometry.kind == ShapeKind::cones ? &geometry.segments[part] : nullptr;
+    const unsigned prim = segment ? segment->cone : part;
+    const Ray& ray = context.rays[id];
+    const double limit = std::min(context.best_t[id], double(tfar));
+    // Up to and including the limit, to see a hit at exactly the t of the one held.
+    ShapeHit hit;
+    if (!intersect_analytic(geometry, prim, ray, next_up(limit), hit)) return false;
+    if (segment && !(hit.u >= segment->owns_from && hit.u < segment->owns_to)) return false;
+    const auto [material, object] = material_and_object(*geometry.scene, geometry.kind, prim);
+    if (hit.t == limit) {
+        // At a triangle's (float) distance, or at the ray's end: the candidate does not win.
+        if (limit != context.best_t[id] || !(limit < ray.t_max)) return false;
+        // An exact tie with the sphere or box held: overlapping boxes with faces in one
+        // plane, or two equal spheres in one place.
+        const Vec3& held = context.best_normal[id];
+        // The exact rule: the tie goes to the first object in the file, whatever order
+        // Embree met them in (which differs from one instruction set to another). So does a
+        // tie with a cone, and a tie that looks the same, under POV-Ray's rules too: its
+        // order (PovrayTestOrder) knows spheres and boxes.
+        const bool by_object = geometry.scene->intersection == Intersection::exact ||
+                               geometry.kind == ShapeKind::cones ||
+                               is_cone_object(*geometry.scene, context.best_object[id]);
+        if (by_object || (material == context.best_material[id] && hit.normal.x == held.x && hit.normal.y == held.y &&
+                          hit.normal.z == held.z)) {
+            if (object > context.best_object[id]) return false;
+        } else if (!povray_tie_replaces(material == context.best_material[id], context.best_edge_tie[id], hit.edge_tie,
+                                        context.best_tied[id])) {
+            return false;
+        }
+    } else {
+        context.best_tied[id] = false;
+    }
+    context.best_t[id] = hit.t;
+    context.best_normal[id] = hit.normal;
+    context.best_edge_tie[id] = hit.edge_tie;
+    context.best_material[id] = material;
+    context.best_object[id] = object;
+    // Round the float distance up so Embree keeps visiting boxes that may hold a closer hit.
+    tfar = next_up(float(hit.t));
+    return true;
+}
+
+bool analytic_blocks(const AnalyticGeometry& geometry, unsigned part, const Ray& ray) {
+    // Any hit on the cone blocks, whichever part's box the ray is in.
+    const unsigned prim = geometry.kind == ShapeKind::cones ? geometry.segments[part].cone : part;
+    ShapeHit hit;
+    return intersect_analytic(geometry, prim, ray, ray.t_max, hit);
+}
+
 void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
     const auto* geometry = static_cast<const AnalyticGeometry*>(args->geometryUserPtr);
     auto* context = reinterpret_cast<QueryContext*>(args->context);
     if (context->gathering) return;  // nearest_triangle's query asks for triangles only
     RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, args->N);
     RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, args->N);
-    // A part of a cone (ConeSegment) reports the cone itself, and only the hit that is its own.
-    const ConeSegment* segment = geometry->kind == ShapeKind::cones ? &geometry->segments[args->primID] : nullptr;
-    const unsigned prim = segment ? segment->cone : args->primID;
+    const unsigned prim = geometry->kind == ShapeKind::cones ? geometry->segments[args->primID].cone : args->primID;
     for (unsigned i = 0; i < args->N; ++i) {
         if (!args->valid[i]) continue;
         const unsigned id = RTCRayN_id(rays, args->N, i);
         if (!context->is_query(id)) continue;
-        const Ray& ray = context->rays[id];
-        const double limit = std::min(context->best_t[id], double(RTCRayN_tfar(rays, args->N, i)));
-        // Up to and including the limit, to see a hit at exactly the t of the one held.
-        ShapeHit hit;
-        if (!intersect_analytic(*geometry, prim, ray, next_up(limit), hit)) continue;
-        if (segment && !(hit.u >= segment->owns_from && hit.u < segment->owns_to)) continue;
-        const auto [material, object] = material_and_object(*geometry->scene, geometry->kind, prim);
-        if (hit.t == limit) {
-            // At a triangle's (float) distance, or at the ray's end: the candidate does not win.
-            if (limit != context->best_t[id] || !(limit < ray.t_max)) continue;
-            // An exact tie with the sphere or box held: overlapping boxes with faces in one
-            // plane, or two equal spheres in one place.
-            const Vec3& held = context->best_normal[id];
-            // The exact rule: the tie goes to the first object in the file, whatever order
-            // Embree met them in (which differs from one instruction set to another). So does a
-            // tie with a cone, and a tie that looks the same, under POV-Ray's rules too: its
-            // order (PovrayTestOrder) knows spheres and boxes.
-            const bool by_object = geometry->scene->intersection == Intersection::exact ||
-                                   geometry->kind == ShapeKind::cones ||
-                                   is_cone_object(*geometry->scene, context->best_object[id]);
-            if (by_object || (material == context->best_material[id] && hit.normal.x == held.x &&
-                              hit.normal.y == held.y && hit.normal.z == held.z)) {
-                if (object > context->best_object[id]) continue;
-            } else if (!povray_tie_replaces(material == context->best_material[id], context->best_edge_tie[id],
-                                            hit.edge_tie, context->best_tied[id])) {
-                continue;
-            }
-        } else {
-            context->best_tied[id] = false;
-        }
-        context->best_t[id] = hit.t;
-        context->best_normal[id] = hit.normal;
-        context->best_edge_tie[id] = hit.edge_tie;
-        context->best_material[id] = material;
-        context->best_object[id] = object;
-        // Round the float distance up so Embree keeps visiting boxes that may hold a closer hit.
-        RTCRayN_tfar(rays, args->N, i) = next_up(float(hit.t));
+        if (!consider_analytic(*geometry, args->primID, *context, id, RTCRayN_tfar(rays, args->N, i))) continue;
+        const Vec3& normal = context->best_normal[id];
         RTCHitN_geomID(hits, args->N, i) = args->geomID;
         RTCHitN_primID(hits, args->N, i) = prim;
         RTCHitN_instID(hits, args->N, i, 0) = RTC_INVALID_GEOMETRY_ID;
         RTCHitN_u(hits, args->N, i) = 0;
         RTCHitN_v(hits, args->N, i) = 0;
-        RTCHitN_Ng_x(hits, args->N, i) = float(hit.normal.x);
-        RTCHitN_Ng_y(hits, args->N, i) = float(hit.normal.y);
-        RTCHitN_Ng_z(hits, args->N, i) = float(hit.normal.z);
+        RTCHitN_Ng_x(hits, args->N, i) = float(normal.x);
+        RTCHitN_Ng_y(hits, args->N, i) = float(normal.y);
+        RTCHitN_Ng_z(hits, args->N, i) = float(normal.z);
     }
 }
 
 void analytic_occluded(const RTCOccludedFunctionNArguments* args) {
     const auto* geometry = static_cast<const AnalyticGeometry*>(args->geometryUserPtr);
     const auto* context = reinterpret_cast<const QueryContext*>(args->context);
-    // Any hit on the cone blocks, whichever part's box the ray is in.
-    const unsigned prim = geometry->kind == ShapeKind::cones ? geometry->segments[args->primID].cone : args->primID;
     for (unsigned i = 0; i < args->N; ++i) {
         if (!args->valid[i]) continue;
         const unsigned id = RTCRayN_id(args->ray, args->N, i);
         if (!context->is_query(id)) continue;
-        const Ray& ray = context->rays[id];
-        ShapeHit hit;
-        if (intersect_analytic(*geometry, prim, ray, ray.t_max, hit))
+        if (analytic_blocks(*geometry, args->primID, context->rays[id]))
             RTCRayN_tfar(args->ray, args->N, i) = -INFINITY;  // Embree's mark for "occluded"
     }
 }
@@ -515,6 +526,18 @@ bool Accelerator::Impl::trace(const Ray& ray, RTCFilterFunctionN filter, HitPart
     QueryContext context(&ray, nullptr, 1, false);
     context.embree.filter = filter;
     context.start(0, ray);
+    if (without_bvh) {
+        float tfar = frame.t_max(ray);
+        unsigned geom = RTC_INVALID_GEOMETRY_ID, prim = 0;
+        for (const DirectShapes& shapes : direct)
+            for (unsigned part = 0; part < shapes.parts; ++part)
+                if (consider_analytic(*shapes.geometry, part, context, 0, tfar)) {
+                    geom = shapes.id;
+                    prim = shapes.geometry->kind == ShapeKind::cones ? shapes.geometry->segments[part].cone : part;
+                }
+        return finish_hit(ray, RTC_INVALID_GEOMETRY_ID, geom, prim, context.best_t[0], context.best_normal[0],
+                          context.best_tied[0], parts, out, retry);
+    }
     RTCRayHit rayhit;
     rayhit.ray = make_embree_ray(ray, 0, frame);
     rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -538,6 +561,12 @@ bool Accelerator::Impl::occluded(const Ray& ray) const {
 
 /// Embree's answer for a shadow ray, the planes aside.
 bool Accelerator::Impl::occluded_in_bvh(const Ray& ray) const {
+    if (without_bvh) {
+        for (const DirectShapes& shapes : direct)
+            for (unsigned part = 0; part < shapes.parts; ++part)
+                if (analytic_blocks(*shapes.geometry, part, ray)) return true;
+        return false;
+    }
     QueryContext context(&ray, nullptr, 1, false);
     context.embree.filter = shadow_filter();
     RTCRay r = make_embree_ray(ray, 0, frame);

@@ -200,6 +200,14 @@ struct EmbreeFrame {
 /// Embree's callbacks (accelerator_exact.cpp): the bounds and the double tests of the spheres,
 /// boxes and cones (user geometry), and the double decision on a triangle candidate.
 void analytic_bounds(const RTCBoundsFunctionArguments* args);
+/// A sphere's, box's or part of a cone's (ConeSegment: `part`) double test for ray `id` of
+/// `context`, as Embree's candidate, or as one of the shapes a scene without a BVH tests on
+/// every ray: true when its hit is now the one held (QueryContext::best_t ...), `tfar`
+/// (Embree's float end of the ray) then moved just past it.
+bool consider_analytic(const AnalyticGeometry& geometry, unsigned part, QueryContext& context, unsigned id,
+                       float& tfar);
+/// Whether that shape blocks the shadow ray `ray`.
+bool analytic_blocks(const AnalyticGeometry& geometry, unsigned part, const Ray& ray);
 void analytic_intersect(const RTCIntersectFunctionNArguments* args);
 void analytic_occluded(const RTCOccludedFunctionNArguments* args);
 void triangle_filter(const RTCFilterFunctionNArguments* args);
@@ -251,8 +259,24 @@ struct Accelerator::Impl {
     mutable tbb::collaborative_once_flag tie_order_built;
     mutable std::unique_ptr<PovrayTestOrder> tie_order_data;
 
+    /// A scene of at most most_shapes_without_bvh spheres, boxes and cones, and nothing else
+    /// but planes, on few rays, has no BVH and no Embree device (worth_no_bvh): every ray tests every shape
+    /// (trace, occluded_in_bvh), with the decisions Embree's callbacks make
+    /// (consider_analytic, analytic_blocks), which do not depend on the order the shapes are
+    /// met in. `direct` lists them: each kind's geomID, as `kinds` knows it, and its count.
+    static constexpr size_t most_shapes_without_bvh = 16;
+    static constexpr double most_tests_without_bvh = 1 << 21;  ///< shapes × rays (worth_no_bvh)
+    struct DirectShapes {
+        unsigned id;
+        const accel::AnalyticGeometry* geometry;
+        unsigned parts;
+    };
+    std::vector<DirectShapes> direct;
+    bool without_bvh = false;
+
     // The build (accelerator_build.cpp).
-    Impl(const Scene& s, int threads, const std::string& instruction_set);
+    Impl(const Scene& s, int threads, const std::string& instruction_set, BvhChoice bvh);
+    bool worth_no_bvh() const;
     ~Impl() { release(); }
     void release();
     RTCBuildQuality build_quality() const;

@@ -183,7 +183,7 @@ void Accelerator::Impl::intersect_packet(const Ray* rays, const bool* active, in
     // at W lanes' cost; so do all rays where Embree has no packets (in_native_groups). The
     // answers are the same either way (decided in double).
     bool traced = false;
-    if (!few_lanes(active, count, single_ray_lanes)) {
+    if (!without_bvh && !few_lanes(active, count, single_ray_lanes)) {
         QueryContext context(rays, active, count, true);
         traced = in_native_groups(count, [&]<int W>(int first) {
             intersect_lanes<W>(context, rays, active, first, count, parts, hits, found);
@@ -222,7 +222,8 @@ void Accelerator::Impl::occluded_packet(const Ray* rays, const bool* active, int
     bool from_here[packet_size];
     active = without_rays_from_afar(rays, active, count, from_here, [&](int i) { blocked[i] = occluded(rays[i]); });
     bool traced = false;
-    if (!few_lanes(active, count, single_ray_lanes)) {  // a few rays go one by one, as in intersect_packet
+    if (!without_bvh && !few_lanes(active, count, single_ray_lanes)) {  // a few rays go one by one, as in
+                                                                        // intersect_packet
         // Planes first (no BVH): a ray a plane blocks needs no Embree query.
         bool query[packet_size];
         for (int i = 0; i < count; ++i) query[i] = active[i] && !(blocked[i] = occluded_by_plane(rays[i]));
