@@ -64,12 +64,14 @@ set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION graphics)
 set(CPACK_STRIP_FILES ON)
 # The shared libraries' packages come from dpkg-shlibdeps; what it cannot see is named here:
-# the Python module's interpreter (it is built for this minor version) and NumPy, which it
-# imports at run time.
+# Embree, which the program and the library load when they first make a BVH
+# (renderer/src/render/embree_library.cpp); the Python module's interpreter (it is built for
+# this minor version) and NumPy, which it imports at run time.
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+set(CPACK_DEBIAN_PACKAGE_DEPENDS "libembree3-3 (>= 3.13)")
 if(WHITTED_BUILD_PYTHON)
-  set(CPACK_DEBIAN_PACKAGE_DEPENDS
-      "python3 (>= ${WHITTED_PYTHON_VERSION}), python3 (<< ${WHITTED_PYTHON_NEXT_VERSION}), python3-numpy")
+  string(APPEND CPACK_DEBIAN_PACKAGE_DEPENDS
+         ", python3 (>= ${WHITTED_PYTHON_VERSION}), python3 (<< ${WHITTED_PYTHON_NEXT_VERSION}), python3-numpy")
 endif()
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "povray")
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS "blender, openmpi-bin")

@@ -668,3 +668,36 @@ def test_ctrl_c_cancels_a_check_and_ends_povray(tmp_path):
         alive = False
     assert not alive, "POV-Ray is still running"
     assert os.listdir(private_tmp) == [], os.listdir(private_tmp)
+
+
+def test_embree_is_loaded_by_the_first_bvh_and_its_absence_raises(tmp_path):
+    """Embree is loaded when a scene first needs a BVH (renderer/src/render/embree_library.cpp):
+    with a file that is not Embree first on the library path, a scene of one sphere still
+    renders (traced without a BVH), and one of a triangle raises RuntimeError naming Embree and
+    its Debian package, in a child interpreter that goes on afterwards."""
+    (tmp_path / "libembree3.so.3").write_text("not a library\n")
+    code = textwrap.dedent("""
+        import whitted
+        light = ([0, 0, 5], [1, 1, 1])
+        material = {"kd": [0.5, 0.5, 0.5]}
+        sphere = (whitted.SceneBuilder().image(8, 6).camera([0, 0, 5], [0, 0, 0]).point_light(*light)
+                  .sphere([0, 0, 0], 1, material).build())
+        print("SPHERE", whitted.render(sphere).shape, flush=True)
+        triangle = (whitted.SceneBuilder().image(8, 6).camera([0, 0, 5], [0, 0, 0]).point_light(*light)
+                    .triangle([-1, -1, 0], [1, -1, 0], [0, 1, 0], material).build())
+        try:
+            whitted.render(triangle)
+            print("TRIANGLE rendered", flush=True)
+        except RuntimeError as e:
+            print("TRIANGLE RuntimeError", str(e), flush=True)
+        print("SPHERE AGAIN", whitted.render(sphere).shape, flush=True)
+    """)
+    env = child_python_env()
+    env["LD_LIBRARY_PATH"] = str(tmp_path) + ":" + env.get("LD_LIBRARY_PATH", "")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, env=env)
+    assert result.returncode == 0, result.stderr[-2000:]
+    lines = result.stdout.splitlines()
+    assert lines[0] == "SPHERE (6, 8, 3)", result.stdout
+    assert lines[1].startswith("TRIANGLE RuntimeError"), result.stdout
+    assert "cannot load Embree" in lines[1] and "libembree3-3" in lines[1], lines[1]
+    assert lines[2] == "SPHERE AGAIN (6, 8, 3)", result.stdout
