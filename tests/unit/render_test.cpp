@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cstring>
 #include <set>
 
@@ -144,6 +145,40 @@ INSTANTIATE_TEST_SUITE_P(OneAndNxN, RenderPerSamples, testing::Values(1, 2, 3),
                          [](const testing::TestParamInfo<int>& samples_info) {
                              return "samples" + std::to_string(samples_info.param);
                          });
+
+// A small image of a scene without a BVH is rendered on the calling thread (renderer.h,
+// most_pixels_on_one_thread); a tile source (RenderJob::next_tile) makes the same tiles go
+// through TBB's worker threads instead. The two give the same bytes, with one sample per pixel
+// (packets) and 2×2: the scene above without its triangles.
+TEST(Render, ASmallImageOnOneThreadIsTheThreadsImage) {
+    for (const int samples : {1, 2}) {
+        std::string text = scene_text(samples);
+        text = text.substr(0, text.find("  - {type: triangle")) + text.substr(text.find("  - {type: plane"));
+        const Scene scene = test::scene_from(text);
+        ASSERT_TRUE(scene.meshes.empty());
+        ASSERT_LE(size_t(scene.width) * scene.height * samples * samples, most_pixels_on_one_thread);
+        const Accelerator accelerator(scene, 2);
+        ASSERT_FALSE(accelerator.has_bvh());
+        RenderJob options;
+        options.threads = 2;
+        const RenderedTiles alone = render(scene, accelerator, options);
+        const size_t tiles = render_tile_count(scene.width, scene.height);
+        std::atomic<size_t> next{0};
+        std::atomic<int> tiles_given{0};
+        options.next_tile = [&](size_t& tile) {
+            tile = next++;
+            if (tile >= tiles) return false;
+            ++tiles_given;
+            return true;
+        };
+        const RenderedTiles threaded = render(scene, accelerator, options);
+        EXPECT_EQ(tiles_given.load(), int(tiles)) << samples;
+        EXPECT_TRUE(same_pixels(alone.image, threaded.image)) << samples << "×" << samples << " samples";
+        EXPECT_EQ(alone.rays.total(), threaded.rays.total()) << samples;
+        const std::set<float> distinct(alone.image.rgb.begin(), alone.image.rgb.end());
+        EXPECT_GT(distinct.size(), 100u) << samples;
+    }
+}
 
 // --stats reports Embree's memory: a BVH over a few thousand triangles holds tens of kilobytes
 // at least (more than the triangles' own 36 bytes each), and the build's peak is no less.

@@ -200,7 +200,7 @@ std::vector<unsigned char> compress_rows(const Samples& samples) {
     std::vector<uLong> sums(band_count);
     std::vector<size_t> lengths(band_count);
     std::atomic<bool> failed{false};
-    tbb::parallel_for(0, bands, [&](int b) {
+    const auto make_band = [&](int b) {
         const int first = b * band, count = std::min(band, height - first);
         const size_t stride = row_bytes + 1, filtered_size = size_t(count) * stride;
         const auto filtered = std::make_unique_for_overwrite<unsigned char[]>(filtered_size);
@@ -240,7 +240,13 @@ std::vector<unsigned char> compress_rows(const Samples& samples) {
         if (status != (last ? Z_STREAM_END : Z_OK) || stream.avail_in != 0) failed = true;
         part.size = bound - stream.avail_out;
         deflateEnd(&stream);
-    });
+    };
+    // One band (an image of at most 64 rows) is made on this thread: starting TBB would cost
+    // more than the band (render/renderer.h, most_pixels_on_one_thread).
+    if (bands == 1)
+        make_band(0);
+    else
+        tbb::parallel_for(0, bands, make_band);
     if (failed) throw std::runtime_error("zlib could not compress the image");
     size_t total = 2 + 4;
     for (const Part& part : parts) total += part.size;

@@ -277,24 +277,30 @@ RenderedTiles render(const Scene& scene, const Accelerator& accelerator, const R
         ++tiles_done;
     };
 
+    const size_t pixels = size_t(scene.width) * size_t(scene.height) * size_t(scene.samples) * size_t(scene.samples);
     const int threads = options.threads > 0 ? options.threads : tbb::this_task_arena::max_concurrency();
-    tbb::task_arena arena(threads);
-    arena.execute([&] {
-        if (options.next_tile) {
-            // One loop per thread, each asking the tile source until it has no more.
-            tbb::parallel_for(0, threads, [&](int) {
-                size_t t;
-                while (!cancelled() && options.next_tile(t)) render_tile(t);
-            });
-            return;
-        }
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, tile_count, 1), [&](const tbb::blocked_range<size_t>& range) {
-            for (size_t i = range.begin(); i != range.end(); ++i) {
-                if (cancelled()) return;
-                render_tile(tile_number(i));
+    if (pixels <= most_pixels_on_one_thread && !accelerator.has_bvh() && !options.next_tile) {
+        for (size_t i = 0; i < tile_count && !cancelled(); ++i) render_tile(tile_number(i));
+    } else {
+        tbb::task_arena arena(threads);
+        arena.execute([&] {
+            if (options.next_tile) {
+                // One loop per thread, each asking the tile source until it has no more.
+                tbb::parallel_for(0, threads, [&](int) {
+                    size_t t;
+                    while (!cancelled() && options.next_tile(t)) render_tile(t);
+                });
+                return;
             }
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, tile_count, 1),
+                              [&](const tbb::blocked_range<size_t>& range) {
+                                  for (size_t i = range.begin(); i != range.end(); ++i) {
+                                      if (cancelled()) return;
+                                      render_tile(tile_number(i));
+                                  }
+                              });
         });
-    });
+    }
 
     if (reporter.joinable()) {
         {

@@ -58,6 +58,12 @@ struct RenderJob {
 /// render() works in square tiles of this many pixels a side, numbered row by row.
 constexpr int render_tile_size = 32;
 size_t render_tile_count(int width, int height);
+/// An image of at most this many samples (pixels × samples per pixel) of a scene without a BVH
+/// (Accelerator::has_bvh: a few shapes, so little work per sample) is rendered on the calling
+/// thread, tile after tile: TBB's start (its allocator, its arena, its worker threads) costs a
+/// process about 2 ms, more than such an image takes on one core (a 64 × 48 sphere: 0.5 ms).
+/// With a BVH, Embree's device has started TBB already. The pixels are the same either way.
+constexpr size_t most_pixels_on_one_thread = 64 * 64;
 TileRect render_tile_rect(int width, int height, size_t tile);
 
 /// What render() gives back: the whole image (black outside the tiles rendered), from which
