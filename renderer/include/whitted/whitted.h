@@ -325,8 +325,9 @@ struct AcceleratorInfo {
     size_t peak_bytes = 0;  ///< Embree's memory at most while building it
     std::string isa;        ///< Embree's instruction set as asked ($WHITTED_EMBREE_ISA); empty: Embree's choice
     int lane_width = 1;     ///< rays per packet given to Embree
-    /// False for a scene of at most 8 spheres, boxes and cones and nothing else but planes:
-    /// each ray tests them all, with the same answers, and Embree makes no device or BVH.
+    /// False for a scene of at most 16 spheres, boxes and cones and nothing else but planes,
+    /// on few rays (shapes × camera rays × (1 + lights) ≤ 2²¹): each ray tests them all, with
+    /// the same answers, and Embree is not loaded for it.
     bool has_bvh = true;
 };
 
