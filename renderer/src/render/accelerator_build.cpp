@@ -74,23 +74,23 @@ Accelerator::Impl::Impl(const Scene& s, int threads, const std::string& instruct
     : scene(s), isa(instruction_set) {
     spheres.scene = boxes.scene = cones.scene = &scene;
     check_reach();  // before Embree holds anything
+    // Without a BVH too, the frame gives each ray the end Embree would have given it.
+    frame = choose_frame();
+    spheres.offset = boxes.offset = cones.offset = frame.offset;
     if (bvh == BvhChoice::when_worthwhile && worth_no_bvh()) {
         // A few spheres, boxes and cones: each ray tests them all (direct), with no Embree
-        // device. The frame still gives each ray the end Embree would have given it.
+        // device.
         if (!isa.empty()) require_embree_isa(isa);  // a setting the CPU cannot run is still an error
         without_bvh = true;
-        frame = choose_frame();
-        spheres.offset = boxes.offset = cones.offset = frame.offset;
         // A cone is one part: the parts are for Embree's boxes, and each hit is the whole
         // cone's either way (ConeSegment).
         constexpr double inf = std::numeric_limits<double>::infinity();
         for (uint32_t c = 0; c < scene.cones.size(); ++c)
             cones.segments.push_back({c, 0.0, scene.cones[c].height, -inf, inf});
+        const std::pair<const accel::AnalyticGeometry*, size_t> kinds_present[] = {
+            {&spheres, scene.spheres.size()}, {&boxes, scene.boxes.size()}, {&cones, cones.segments.size()}};
         unsigned id = 0;
-        for (const accel::AnalyticGeometry* shapes : {&spheres, &boxes, &cones}) {
-            const size_t count = shapes == &spheres ? scene.spheres.size()
-                                 : shapes == &boxes ? scene.boxes.size()
-                                                    : cones.segments.size();
+        for (const auto& [shapes, count] : kinds_present) {
             if (count == 0) continue;
             direct.push_back({id, shapes, unsigned(count)});
             record(id++, shapes->kind, 0);
@@ -113,8 +113,6 @@ Accelerator::Impl::Impl(const Scene& s, int threads, const std::string& instruct
     // Context filter: triangle_filter is set on the context of a ray traced again, and of
     // shadow rays (Impl::intersect, Impl::occluded).
     rtcSetSceneFlags(rtc_scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
-    frame = choose_frame();
-    spheres.offset = boxes.offset = cones.offset = frame.offset;
     size_t most_triangles = 0;
     for (const TriangleMesh& mesh : scene.meshes) most_triangles = std::max(most_triangles, mesh.triangle_count());
     for (const Prototype& prototype : scene.prototypes)
