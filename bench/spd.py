@@ -10,6 +10,12 @@ its own way (ambient, its own highlight, no 1/√N lights) and draws some databa
 (the teapot mirrored, gears blank); Whitted's image is the one `whitted check` compares with
 POV-Ray (tests/nff, label spd).
 
+Tachyon draws each NFF light as a white ball. A database with a light nearer the eye than its
+hither distance (gears: its fifth light is 0.034 from the eye, hither 1) is blank in Tachyon's
+image, every camera ray ending on that ball, so its time there is not the database's work. For
+such a database a second row renders, with both programs, a copy written to OUT_DIR without
+those lights: NAME-no-eye-light.nff ("NAME, lights at the eye left out").
+
 Usage: bench/spd.py WHITTED OUT_DIR [--runs N] [--threads T] [--corpus DIR] [--databases a,b]"""
 import argparse
 import os
@@ -40,6 +46,34 @@ def count_primitives(path):
     return counts
 
 
+def lights_at_the_eye(path):
+    """The lines of `path`'s lights nearer the eye ("from") than the hither distance: a light
+    there is nothing the camera should see (the NFF document's positional light is a point),
+    but Tachyon's ball around it covers the view."""
+    eye, hither, lights = None, 0.0, []
+    with open(path, "rb") as f:
+        for number, line in enumerate(f):
+            words = line.split()
+            if not words:
+                continue
+            if words[0] == b"from" and len(words) >= 4:
+                eye = [float(w) for w in words[1:4]]
+            elif words[0] == b"hither" and len(words) >= 2:
+                hither = float(words[1])
+            elif words[0] == b"l" and len(words) >= 4:
+                lights.append((number, [float(w) for w in words[1:4]]))
+    if eye is None:
+        return set()
+    return {n for n, at in lights if sum((a - e) ** 2 for a, e in zip(at, eye)) < hither * hither}
+
+
+def without_lines(path, lines, out):
+    """A copy of `path` at `out` without the given line numbers (0-based)."""
+    with open(path, "rb") as f, open(out, "wb") as o:
+        o.writelines(line for number, line in enumerate(f) if number not in lines)
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("whitted")
@@ -59,10 +93,18 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
 
     rows = []
+    work = []
     for name in args.databases.split(","):
         scene = corpus / f"{name}.nff"
         if not scene.is_file():
             sys.exit(f"bench: {scene} is missing")
+        work.append((name, scene))
+        at_the_eye = lights_at_the_eye(scene)
+        if at_the_eye:
+            copy = without_lines(scene, at_the_eye, out / f"{name}-no-eye-light.nff")
+            work.append((f"{name}, lights at the eye left out", copy))
+    for label, scene in work:
+        name = scene.stem
         ours = [args.whitted, "render", scene, "-o", out / f"{name}.whitted.png", "--threads", str(args.threads),
                 "--quiet"]
         theirs = [tachyon, scene, "-numthreads", str(args.threads), "-o", out / f"{name}.tachyon.tga", "-format",
@@ -74,9 +116,9 @@ def main():
             t.append(timed(theirs))
         med = lambda xs, i: statistics.median(x[i] for x in xs)  # noqa: E731
         ratios = [b[0] / a[0] for a, b in zip(w, t)]
-        rows.append((name, count_primitives(scene), med(w, 0), med(t, 0), statistics.median(ratios), med(w, 1),
+        rows.append((label, count_primitives(scene), med(w, 0), med(t, 0), statistics.median(ratios), med(w, 1),
                      med(t, 1)))
-        print(f"{name}: Whitted {med(w, 0):.3f} s, Tachyon {med(t, 0):.3f} s, "
+        print(f"{label}: Whitted {med(w, 0):.3f} s, Tachyon {med(t, 0):.3f} s, "
               f"Tachyon/Whitted {statistics.median(ratios):.2f}x", file=sys.stderr)
 
     print(f"\n{args.runs} interleaved runs each, {args.threads} threads, whole process, medians\n")
