@@ -79,6 +79,53 @@ TEST(Sphere, MissesBehindBesideAndBeyondRange) {
     EXPECT_TRUE(intersect_sphere(sphere, ray_from({0, 0, 0}, {0, 0, -1}), t_min, 4.1, hit));
 }
 
+// A shadow ray's test (sphere_blocks) finds a hit exactly where intersect_sphere does: the
+// same cases as above, then random spheres, plain and transformed, with each ray's span ending
+// just short of, at, and just past the hit intersect_sphere reports (both exclude t_max itself),
+// and starting inside.
+TEST(Sphere, BlocksExactlyWhereItIsHit) {
+    const Sphere near{nullptr, {0, 0, -5}, 1, 0};
+    EXPECT_FALSE(sphere_blocks(near, ray_from({0, 0, 0}, {0, 0, 1}), t_min, t_max));
+    EXPECT_FALSE(sphere_blocks(near, ray_from({1.01, 0, 0}, {0, 0, -1}), t_min, t_max));
+    EXPECT_FALSE(sphere_blocks(near, ray_from({0, 0, 0}, {0, 0, -1}), t_min, 3.9));
+    EXPECT_TRUE(sphere_blocks(near, ray_from({0, 0, 0}, {0, 0, -1}), t_min, 4.1));
+    EXPECT_TRUE(sphere_blocks(near, ray_from({0, 0, -5}, {1, 2, 3}), t_min, 1.1));  // from the centre: r away
+
+    std::mt19937_64 random(38);
+    std::uniform_real_distribution<double> coordinate(-10, 10), radius(0.01, 5), scale(0.2, 3);
+    int hits = 0, cases = 0;
+    for (int i = 0; i < 20000; ++i) {
+        Sphere sphere{nullptr, {coordinate(random), coordinate(random), coordinate(random)}, radius(random), 0};
+        if (i % 3 == 0)
+            sphere.object_to_world = std::make_shared<const Transform>(
+                Transform::scale({scale(random), scale(random), scale(random)})
+                    .then(Transform::translate({coordinate(random), coordinate(random), coordinate(random)})));
+        // Aimed near the sphere's world centre, so about half the rays meet it.
+        const Vec3 origin{coordinate(random), coordinate(random), coordinate(random)};
+        const Vec3 centre = sphere.object_to_world ? sphere.object_to_world->apply_point(sphere.center) : sphere.center;
+        const Vec3 aim = centre + Vec3{coordinate(random), coordinate(random), coordinate(random)} * 0.3;
+        if (length(aim - origin) == 0) continue;
+        const Ray ray = ray_from(origin, aim - origin);
+        ShapeHit hit;
+        const bool found = intersect_sphere(sphere, ray, t_min, t_max, hit);
+        ASSERT_EQ(sphere_blocks(sphere, ray, t_min, t_max), found) << i;
+        ++cases;
+        if (!found) continue;
+        ++hits;
+        for (const double end : {std::nextafter(hit.t, 0.0), hit.t, std::nextafter(hit.t, t_max)}) {
+            ShapeHit shorter;
+            ASSERT_EQ(sphere_blocks(sphere, ray, t_min, end), intersect_sphere(sphere, ray, t_min, end, shorter))
+                << i << " end " << end;
+        }
+        // From just past the hit: the far side, or nothing.
+        const double start = std::nextafter(hit.t, t_max);
+        ShapeHit beyond;
+        ASSERT_EQ(sphere_blocks(sphere, ray, start, t_max), intersect_sphere(sphere, ray, start, t_max, beyond)) << i;
+    }
+    EXPECT_GT(hits, cases / 5);  // the sample meets the spheres often enough to mean something
+    EXPECT_LT(hits, cases);
+}
+
 // The unit sphere scaled by (2, 1, 1) is the ellipsoid x²/4 + y² + z² = 1, whose normal is the
 // gradient ∝ (x/4, y, z): the inverse transpose of the scale, not the scaled radius vector.
 TEST(Sphere, NonUniformScaleUsesInverseTransposeNormal) {

@@ -98,6 +98,13 @@ bool intersect_sphere(const Sphere& sphere, const Ray& world_ray, double t_min, 
     return true;
 }
 
+bool sphere_blocks(const Sphere& sphere, const Ray& world_ray, double t_min, double t_max) {
+    double t;
+    if (!sphere.object_to_world) return sphere_hit(sphere, world_ray.origin, world_ray.direction, t_min, t_max, t);
+    const Ray ray = to_object_space(*sphere.object_to_world, world_ray);
+    return sphere_hit(sphere, ray.origin, ray.direction, t_min, t_max, t);
+}
+
 bool intersect_box(const Box& box, const Ray& world_ray, double t_min, double t_max, ShapeHit& hit) {
     const Ray ray = to_object_space(transform_of(box.object_to_world), world_ray);
     // The slab test, axis by axis in the order x, y, z, with no tolerance: the span is where

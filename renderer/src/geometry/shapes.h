@@ -27,6 +27,9 @@ struct ShapeHit {
 Ray to_object_space(const Transform& to_world, const Ray& ray);
 
 bool intersect_sphere(const Sphere& sphere, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
+/// Whether intersect_sphere finds a hit, decided by the same arithmetic, without the normal: a
+/// shadow ray needs only that.
+bool sphere_blocks(const Sphere& sphere, const Ray& ray, double t_min, double t_max);
 /// The slab test, exact: no tolerance but t_min; a ray through an edge or corner gets the face
 /// of the last axis it crosses there. (POV-Ray's, for `whitted check`: compat/povray/box.h.)
 bool intersect_box(const Box& box, const Ray& ray, double t_min, double t_max, ShapeHit& hit);

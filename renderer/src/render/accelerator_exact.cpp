@@ -181,6 +181,8 @@ bool consider_analytic(const AnalyticGeometry& geometry, unsigned part, QueryCon
 
 bool analytic_blocks(const AnalyticGeometry& geometry, unsigned part, const Ray& ray) {
     // Any hit on the cone blocks, whichever part's box the ray is in.
+    if (geometry.kind == ShapeKind::spheres)
+        return sphere_blocks(geometry.scene->spheres[part], ray, ray.t_min, ray.t_max);
     const unsigned prim = geometry.kind == ShapeKind::cones ? geometry.segments[part].cone : part;
     ShapeHit hit;
     return intersect_analytic(geometry, prim, ray, ray.t_max, hit);
