@@ -55,53 +55,19 @@ Ray to_object_space(const Transform& to_world, const Ray& ray) {
     return {to_world.inverse_point(ray.origin), to_world.inverse_vector(ray.direction), ray.t_min, ray.t_max};
 }
 
-namespace {
-
-/// The sphere test on a ray already in the sphere's own space. Called for every lane of every
-/// candidate in a packet, so it rejects a miss with the fewest operations (no division, no sqrt).
-inline bool sphere_hit(const Sphere& sphere, const Vec3& origin, const Vec3& direction, double t_min, double t_max,
-                       double& t) {
-    // Closest approach along the ray, then half the chord. The squared distance of the centre
-    // from the ray is taken from the perpendicular vector itself, not as |oc|² − along²/a: for a
-    // small sphere far away those two are nearly equal and their difference loses every digit
-    // of r² (a sphere of radius 1e-3 at 1e5 gets about none right). Scaled by a so that the sign
-    // decides a miss before any division: a·oc − along·d = a·(perpendicular vector).
-    const Vec3 to_center = sphere.center - origin;
-    const double along = dot(to_center, direction);
-    const double a = dot(direction, direction);
-    const Vec3 scaled_perpendicular = to_center * a - direction * along;
-    // a²·r² − |a·perpendicular|² = a²·(r² − distance²) = a³·half_chord² (t units).
-    const double scaled_half_chord2 =
-        a * a * sphere.radius * sphere.radius - dot(scaled_perpendicular, scaled_perpendicular);
-    if (scaled_half_chord2 < 0) return false;
-    const double closest = along / a;
-    const double half_chord = std::sqrt(scaled_half_chord2 / a) / a;
-    t = closest - half_chord;
-    if (!(t > t_min)) t = closest + half_chord;  // the ray starts inside (or past the near side)
-    return t > t_min && t < t_max;
-}
-
-}  // namespace
-
-bool intersect_sphere(const Sphere& sphere, const Ray& world_ray, double t_min, double t_max, ShapeHit& hit) {
-    double t;
-    if (!sphere.object_to_world) {
-        if (!sphere_hit(sphere, world_ray.origin, world_ray.direction, t_min, t_max, t)) return false;
-        hit.t = t;
-        hit.normal = (world_ray.at(t) - sphere.center) / sphere.radius;
-        return true;
-    }
+bool intersect_transformed_sphere(const Sphere& sphere, const Ray& world_ray, double t_min, double t_max,
+                                  ShapeHit& hit) {
     const Ray ray = to_object_space(*sphere.object_to_world, world_ray);
+    double t;
     if (!sphere_hit(sphere, ray.origin, ray.direction, t_min, t_max, t)) return false;
     hit.t = t;
     hit.normal = sphere.object_to_world->apply_normal((ray.at(t) - sphere.center) / sphere.radius);
     return true;
 }
 
-bool sphere_blocks(const Sphere& sphere, const Ray& world_ray, double t_min, double t_max) {
-    double t;
-    if (!sphere.object_to_world) return sphere_hit(sphere, world_ray.origin, world_ray.direction, t_min, t_max, t);
+bool transformed_sphere_blocks(const Sphere& sphere, const Ray& world_ray, double t_min, double t_max) {
     const Ray ray = to_object_space(*sphere.object_to_world, world_ray);
+    double t;
     return sphere_hit(sphere, ray.origin, ray.direction, t_min, t_max, t);
 }
 

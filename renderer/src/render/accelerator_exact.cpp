@@ -41,15 +41,29 @@ std::pair<uint32_t, uint32_t> material_and_object(const Scene& scene, ShapeKind 
     return {scene.boxes[prim].material, scene.boxes[prim].object};
 }
 
+/// The double test of shape `prim` of a geometry of kind `Kind`. The kind is a template
+/// argument so that a callback's loop over its lanes chooses the test once, and inlines the
+/// sphere's.
+template <ShapeKind Kind>
 bool intersect_analytic(const AnalyticGeometry& geometry, unsigned prim, const Ray& ray, double t_max, ShapeHit& hit) {
-    if (geometry.kind == ShapeKind::spheres)
+    if constexpr (Kind == ShapeKind::spheres) {
         return intersect_sphere(geometry.scene->spheres[prim], ray, ray.t_min, t_max, hit);
-    if (geometry.kind == ShapeKind::cones)
+    } else if constexpr (Kind == ShapeKind::cones) {
         return intersect_cone(geometry.scene->cones[prim], ray, ray.t_min, t_max, hit);
-    const Box& box = geometry.scene->boxes[prim];
-    return geometry.scene->intersection == Intersection::povray
-               ? intersect_box_as_povray(box, ray, ray.t_min, t_max, hit)
-               : intersect_box(box, ray, ray.t_min, t_max, hit);
+    } else {
+        const Box& box = geometry.scene->boxes[prim];
+        return geometry.scene->intersection == Intersection::povray
+                   ? intersect_box_as_povray(box, ray, ray.t_min, t_max, hit)
+                   : intersect_box(box, ray, ray.t_min, t_max, hit);
+    }
+}
+
+/// Calls `body.template operator()<Kind>()` with `kind` as a template argument.
+template <class Body>
+decltype(auto) with_kind(ShapeKind kind, Body&& body) {
+    if (kind == ShapeKind::spheres) return body.template operator()<ShapeKind::spheres>();
+    if (kind == ShapeKind::cones) return body.template operator()<ShapeKind::cones>();
+    return body.template operator()<ShapeKind::boxes>();
 }
 
 /// Whether Scene::objects number `object` (index + 1) is a cylinder or cone.
@@ -134,16 +148,18 @@ void analytic_bounds(const RTCBoundsFunctionArguments* args) {
     args->bounds_o->upper_z = std::nextafter(float(hi.z), INFINITY);
 }
 
-bool consider_analytic(const AnalyticGeometry& geometry, unsigned part, QueryContext& context, unsigned id,
-                       float& tfar) {
+namespace {
+
+template <ShapeKind Kind>
+bool consider(const AnalyticGeometry& geometry, unsigned part, QueryContext& context, unsigned id, float& tfar) {
     // A part of a cone (ConeSegment) reports the cone itself, and only the hit that is its own.
-    const ConeSegment* segment = geometry.kind == ShapeKind::cones ? &geometry.segments[part] : nullptr;
+    const ConeSegment* segment = Kind == ShapeKind::cones ? &geometry.segments[part] : nullptr;
     const unsigned prim = segment ? segment->cone : part;
     const Ray& ray = context.rays[id];
     const double limit = std::min(context.best_t[id], double(tfar));
     // Up to and including the limit, to see a hit at exactly the t of the one held.
     ShapeHit hit;
-    if (!intersect_analytic(geometry, prim, ray, next_up(limit), hit)) return false;
+    if (!intersect_analytic<Kind>(geometry, prim, ray, next_up(limit), hit)) return false;
     if (segment && !(hit.u >= segment->owns_from && hit.u < segment->owns_to)) return false;
     const auto [material, object] = material_and_object(*geometry.scene, geometry.kind, prim);
     if (hit.t == limit) {
@@ -179,28 +195,30 @@ bool consider_analytic(const AnalyticGeometry& geometry, unsigned part, QueryCon
     return true;
 }
 
-bool analytic_blocks(const AnalyticGeometry& geometry, unsigned part, const Ray& ray) {
-    // Any hit on the cone blocks, whichever part's box the ray is in.
-    if (geometry.kind == ShapeKind::spheres)
+template <ShapeKind Kind>
+bool blocks(const AnalyticGeometry& geometry, unsigned part, const Ray& ray) {
+    if constexpr (Kind == ShapeKind::spheres) {
         return sphere_blocks(geometry.scene->spheres[part], ray, ray.t_min, ray.t_max);
-    const unsigned prim = geometry.kind == ShapeKind::cones ? geometry.segments[part].cone : part;
-    ShapeHit hit;
-    return intersect_analytic(geometry, prim, ray, ray.t_max, hit);
+    } else {
+        // Any hit on the cone blocks, whichever part's box the ray is in.
+        const unsigned prim = Kind == ShapeKind::cones ? geometry.segments[part].cone : part;
+        ShapeHit hit;
+        return intersect_analytic<Kind>(geometry, prim, ray, ray.t_max, hit);
+    }
 }
 
-void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
-    const auto* geometry = static_cast<const AnalyticGeometry*>(args->geometryUserPtr);
-    auto* context = reinterpret_cast<QueryContext*>(args->context);
-    if (context->gathering) return;  // nearest_triangle's query asks for triangles only
+template <ShapeKind Kind>
+void intersect_lanes(const RTCIntersectFunctionNArguments* args, const AnalyticGeometry& geometry,
+                     QueryContext& context) {
     RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, args->N);
     RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, args->N);
-    const unsigned prim = geometry->kind == ShapeKind::cones ? geometry->segments[args->primID].cone : args->primID;
+    const unsigned prim = Kind == ShapeKind::cones ? geometry.segments[args->primID].cone : args->primID;
     for (unsigned i = 0; i < args->N; ++i) {
         if (!args->valid[i]) continue;
         const unsigned id = RTCRayN_id(rays, args->N, i);
-        if (!context->is_query(id)) continue;
-        if (!consider_analytic(*geometry, args->primID, *context, id, RTCRayN_tfar(rays, args->N, i))) continue;
-        const Vec3& normal = context->best_normal[id];
+        if (!context.is_query(id)) continue;
+        if (!consider<Kind>(geometry, args->primID, context, id, RTCRayN_tfar(rays, args->N, i))) continue;
+        const Vec3& normal = context.best_normal[id];
         RTCHitN_geomID(hits, args->N, i) = args->geomID;
         RTCHitN_primID(hits, args->N, i) = prim;
         RTCHitN_instID(hits, args->N, i, 0) = RTC_INVALID_GEOMETRY_ID;
@@ -212,16 +230,41 @@ void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
     }
 }
 
-void analytic_occluded(const RTCOccludedFunctionNArguments* args) {
-    const auto* geometry = static_cast<const AnalyticGeometry*>(args->geometryUserPtr);
-    const auto* context = reinterpret_cast<const QueryContext*>(args->context);
+template <ShapeKind Kind>
+void occluded_lanes(const RTCOccludedFunctionNArguments* args, const AnalyticGeometry& geometry,
+                    const QueryContext& context) {
     for (unsigned i = 0; i < args->N; ++i) {
         if (!args->valid[i]) continue;
         const unsigned id = RTCRayN_id(args->ray, args->N, i);
-        if (!context->is_query(id)) continue;
-        if (analytic_blocks(*geometry, args->primID, context->rays[id]))
+        if (!context.is_query(id)) continue;
+        if (blocks<Kind>(geometry, args->primID, context.rays[id]))
             RTCRayN_tfar(args->ray, args->N, i) = -INFINITY;  // Embree's mark for "occluded"
     }
+}
+
+}  // namespace
+
+bool consider_analytic(const AnalyticGeometry& geometry, unsigned part, QueryContext& context, unsigned id,
+                       float& tfar) {
+    return with_kind(geometry.kind,
+                     [&]<ShapeKind Kind>() { return consider<Kind>(geometry, part, context, id, tfar); });
+}
+
+bool analytic_blocks(const AnalyticGeometry& geometry, unsigned part, const Ray& ray) {
+    return with_kind(geometry.kind, [&]<ShapeKind Kind>() { return blocks<Kind>(geometry, part, ray); });
+}
+
+void analytic_intersect(const RTCIntersectFunctionNArguments* args) {
+    const auto* geometry = static_cast<const AnalyticGeometry*>(args->geometryUserPtr);
+    auto* context = reinterpret_cast<QueryContext*>(args->context);
+    if (context->gathering) return;  // nearest_triangle's query asks for triangles only
+    with_kind(geometry->kind, [&]<ShapeKind Kind>() { intersect_lanes<Kind>(args, *geometry, *context); });
+}
+
+void analytic_occluded(const RTCOccludedFunctionNArguments* args) {
+    const auto* geometry = static_cast<const AnalyticGeometry*>(args->geometryUserPtr);
+    const auto* context = reinterpret_cast<const QueryContext*>(args->context);
+    with_kind(geometry->kind, [&]<ShapeKind Kind>() { occluded_lanes<Kind>(args, *geometry, *context); });
 }
 
 /// Filter call `args`'s candidate `i` (a triangle) by the double test, on the ray as its mesh
