@@ -66,6 +66,7 @@ inline bool intersect_sphere(const Sphere& sphere, const Ray& ray, double t_min,
     hit.normal = (ray.at(t) - sphere.center) / sphere.radius;
     return true;
 }
+
 /// Whether intersect_sphere finds a hit, decided by the same arithmetic, without the normal: a
 /// shadow ray needs only that.
 inline bool sphere_blocks(const Sphere& sphere, const Ray& ray, double t_min, double t_max) {
@@ -73,6 +74,7 @@ inline bool sphere_blocks(const Sphere& sphere, const Ray& ray, double t_min, do
     double t;
     return sphere_hit(sphere, ray.origin, ray.direction, t_min, t_max, t);
 }
+
 /// The slab test, exact: no tolerance but t_min; a ray through an edge or corner gets the face
 /// of the last axis it crosses there. (POV-Ray's, for `whitted check`: compat/povray/box.h.)
 bool intersect_box(const Box& box, const Ray& ray, double t_min, double t_max, ShapeHit& hit);
