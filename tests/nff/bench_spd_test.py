@@ -60,15 +60,14 @@ def rule(work):
     expect("the copy", kept, [line for n, line in enumerate(text.splitlines()) if n not in chosen])
 
     # hither 0: no light is nearer than that, even one at the eye; no view: nothing to compare with.
-    expect("hither 0", spd.lights_at_the_eye(write(os.path.join(work, "h0.nff"), VIEW.format(hither=0) + "l 0 0 -10\n")),
-           set())
+    at_eye = write(os.path.join(work, "h0.nff"), VIEW.format(hither=0) + "l 0 0 -10\n")
+    expect("hither 0", spd.lights_at_the_eye(at_eye), set())
     expect("no view", spd.lights_at_the_eye(write(os.path.join(work, "nv.nff"), "l 0 0 0\ns 0 0 0 1\n")), set())
     # A word that is not a number (the render reports it) leaves its line out of the choice.
     expect("an unreadable eye",
            spd.lights_at_the_eye(write(os.path.join(work, "bad.nff"), "v\nfrom 0 0 x\nhither 1\nl 0 0 0\n")), set())
-    expect("an unreadable light",
-           spd.lights_at_the_eye(write(os.path.join(work, "badl.nff"), VIEW.format(hither=1) + "l 0 0 -1e\nl 0 0 -10\n")),
-           {first_light + 1})
+    unreadable = write(os.path.join(work, "badl.nff"), VIEW.format(hither=1) + "l 0 0 -1e\nl 0 0 -10\n")
+    expect("an unreadable light", spd.lights_at_the_eye(unreadable), {first_light + 1})
     print("the rule holds: lights strictly within hither of the eye, and only those, are left out")
 
 
