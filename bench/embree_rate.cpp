@@ -172,7 +172,13 @@ void read_scene(const char* path, RTCDevice device, RTCScene rtc, Scene& scene) 
     Shape spheres;
     spheres.kind = Shape::spheres;
     std::string line, item;
+    size_t line_number = 0;
+    const auto refuse = [&](const std::string& why) {
+        throw std::runtime_error(std::string(path) + ":" + std::to_string(line_number) + ": " + why +
+                                 " (bench/embree_rate.py writes these files from a scene)");
+    };
     while (std::getline(file, line)) {
+        ++line_number;
         std::istringstream in(line);
         if (!(in >> item)) continue;
         if (item == "camera") {
@@ -204,9 +210,14 @@ void read_scene(const char* path, RTCDevice device, RTCScene rtc, Scene& scene) 
             float km, m[12];
             in >> obj >> km;
             for (float& x : m) in >> x;
+            if (!in) refuse("a mesh line needs a file, km and 12 numbers");
             add_mesh(device, rtc, scene, obj, km, m);
+        } else {
+            refuse("'" + item + "' is not an item of a .rays file");
         }
+        if (in.fail()) refuse("a number is missing or not a number");
     }
+    if (scene.width <= 0 || scene.height <= 0) refuse("no 'image WIDTH HEIGHT' line");
     if (!sphere_data.empty()) {
         // All the spheres in one geometry: Embree's own sphere primitive, or user geometry.
         RTCGeometry geometry;
@@ -402,10 +413,10 @@ double render(const Scene& scene, RTCScene rtc, Counts& counts) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-    if (argc < 2) {
-        std::fprintf(stderr, "usage: %s SCENE.rays [--threads N]\n", argv[0]);
-        return 2;
+int run(int argc, char** argv) {
+    if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
+        std::fprintf(argc < 2 ? stderr : stdout, "usage: %s SCENE.rays [--threads N] [--sphere-points]\n", argv[0]);
+        return argc < 2 ? 2 : 0;
     }
     int threads = 2;
     Scene scene;
@@ -445,7 +456,9 @@ int main(int argc, char** argv) {
         rtcSetGeometryBuildQuality(geometry, quality);
         rtcCommitGeometry(geometry);
     }
+    const auto build_start = std::chrono::steady_clock::now();
     rtcCommitScene(rtc);
+    const double build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
     const int width = rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED)  ? 16
                       : rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) ? 8
                                                                                                 : 4;
@@ -460,8 +473,19 @@ int main(int argc, char** argv) {
     std::printf("rays: camera %llu shadow %llu reflected %llu total %llu\n", (unsigned long long)counts.camera.load(),
                 (unsigned long long)counts.shadow.load(), (unsigned long long)counts.reflected.load(),
                 (unsigned long long)total);
+    std::printf("build %.4f s (rtcCommitScene)\n", build_seconds);
     std::printf("trace %.4f s, %.2f M rays/s\n", seconds, double(total) / seconds / 1e6);
     rtcReleaseScene(rtc);
     rtcReleaseDevice(device);
     return 0;
+}
+
+int main(int argc, char** argv) {
+    // A file that cannot be read or is not a .rays file is a message and exit 1, not an abort.
+    try {
+        return run(argc, argv);
+    } catch (const std::exception& error) {
+        std::fprintf(stderr, "%s: %s\n", argv[0], error.what());
+        return 1;
+    }
 }
