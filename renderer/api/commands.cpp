@@ -135,6 +135,10 @@ Expected<void> check_embree_isa() {
     });
 }
 
+void use_huge_pages(bool on) {
+    whitted::use_huge_pages(on);
+}
+
 std::string printable(const std::string& text, size_t max_characters) {
     return whitted::printable(text, max_characters);
 }

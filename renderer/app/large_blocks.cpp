@@ -7,8 +7,18 @@
 // page fault. On the virtual machines Whitted is measured on each fault costs ~11 µs, a 15 MB
 // image about 40 ms, a 1M-triangle mesh tens of thousands of faults. One madvise that maps the
 // block's pages costs about half as much as faulting them one by one (docs/performance.md,
-// "Design choices and what they cost"). Huge pages would spare more but cost more on hosts that
-// reclaim a guest's free memory in 2 MiB blocks: main() turns them off.
+// "Design choices and what they cost").
+//
+// Huge pages, where they pay: under a hypervisor that keeps the guest's page tables in shadow
+// (PVM, the AMD virtual machine of docs/performance.md), the first write to every 4 KiB page
+// traps to the host even after the kernel has mapped it, about 5 µs each; a 2 MiB transparent
+// huge page is one such trap for 512 pages. Under hardware-assisted paging the same write costs
+// a fraction of a microsecond, and where the host takes back the guest's free memory in 2 MiB
+// blocks a huge page's first touch costs the host 512 faults of its own (an Intel virtual
+// machine under KVM: a million triangles' BVH built three times slower). Neither is known in
+// advance, so main() measures it (first_write_microseconds) and the program uses huge pages,
+// for its blocks of 2 MiB or more and for Embree's, only where a 4 KiB page's first write takes
+// huge_pages_from_microseconds or more; elsewhere it turns them off for the process.
 //
 // Blocks larger than 256 MiB (or an eighth of the machine's memory, if less) are left to fault as
 // they are written: a caller may reserve more than it fills (a buffer sized by a file's header,
@@ -50,8 +60,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <limits>
 #include <new>
 
 #ifndef MADV_POPULATE_WRITE
@@ -59,6 +74,62 @@
 #endif
 
 namespace whitted::large_blocks {
+
+namespace {
+std::atomic<bool> g_huge_pages{false};
+}  // namespace
+
+size_t huge_from() {
+    return size_t(2) << 20;
+}
+
+void use_huge_pages(bool on) {
+    g_huge_pages.store(on, std::memory_order_relaxed);
+}
+
+bool huge_pages() {
+    return g_huge_pages.load(std::memory_order_relaxed);
+}
+
+bool system_offers_huge_pages() {
+    // "always [madvise] never": the bracketed word is the setting; "never" refuses MADV_HUGEPAGE.
+    std::FILE* file = std::fopen("/sys/kernel/mm/transparent_hugepage/enabled", "r");
+    if (!file) return false;
+    char text[128] = {};
+    const size_t read = std::fread(text, 1, sizeof text - 1, file);
+    std::fclose(file);
+    text[read] = '\0';
+    return std::strstr(text, "[always]") != nullptr || std::strstr(text, "[madvise]") != nullptr;
+}
+
+double first_write_microseconds() {
+    // Eight pages, each mapped and written once first so that what is timed is not the host's
+    // own first touch of memory it had taken back, then given back to the kernel and mapped
+    // and written again (MADV_POPULATE_WRITE as populate() does, then one byte a page), three
+    // times; the least of the three, per page. Under shadow paging each page's write traps.
+    constexpr size_t pages = 8;
+    const size_t page = size_t(sysconf(_SC_PAGESIZE));
+    const size_t bytes = pages * page;
+    void* mapping = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (mapping == MAP_FAILED) return 0;
+    ::madvise(mapping, bytes, MADV_NOHUGEPAGE);  // 4 KiB pages whatever the system's setting
+    volatile char* bytes_of = static_cast<volatile char*>(mapping);
+    const auto touch = [&] {
+        ::madvise(mapping, bytes, MADV_POPULATE_WRITE);
+        for (size_t k = 0; k < pages; ++k) bytes_of[k * page] = char(k + 1);
+    };
+    touch();
+    double least = std::numeric_limits<double>::infinity();
+    for (int trial = 0; trial < 3; ++trial) {
+        ::madvise(mapping, bytes, MADV_DONTNEED);
+        const auto start = std::chrono::steady_clock::now();
+        touch();
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        least = std::min(least, seconds);
+    }
+    ::munmap(mapping, bytes);
+    return least * 1e6 / double(pages);
+}
 
 size_t populated_from() {
     return size_t(1) << 20;
@@ -114,6 +185,17 @@ namespace {
 
 /// The standard's loop: ask the new-handler for memory until it gives up by throwing.
 void* allocate_or_throw(std::size_t size) {
+    namespace blocks = whitted::large_blocks;
+    if (size >= blocks::huge_from() && blocks::huge_pages()) {
+        // On 2 MiB boundaries and in whole huge pages, left to fault as written: each of them is
+        // then one fault (populating them would take as long as writing them).
+        const size_t huge = blocks::huge_from(), rounded = (size + huge - 1) / huge * huge;
+        void* block = nullptr;
+        if (rounded >= size && posix_memalign(&block, huge, rounded) == 0) {
+            ::madvise(block, rounded, MADV_HUGEPAGE);
+            return block;
+        }
+    }
     for (;;) {
         if (void* block = std::malloc(size == 0 ? 1 : size)) {
             whitted::large_blocks::populate(block, size);

@@ -23,4 +23,21 @@ void keep_freed_memory();
 size_t mapped_from();
 size_t kept_free();
 
+/// Transparent huge pages (large_blocks.cpp says where they pay). With use_huge_pages(true),
+/// operator new gives each block of huge_from() (2 MiB) or more on 2 MiB boundaries, rounded
+/// up to whole 2 MiB, asks for huge pages for it (MADV_HUGEPAGE) and leaves it unmapped;
+/// otherwise, as by default, such a block is populated like any other in the range above.
+size_t huge_from();
+void use_huge_pages(bool on);
+bool huge_pages();
+/// Whether the system gives huge pages to memory that asks for them (its setting `always` or
+/// `madvise`, not `never`).
+bool system_offers_huge_pages();
+/// What the first write to a 4 KiB page of fresh memory costs this process, in microseconds:
+/// the page mapped by the kernel (MADV_POPULATE_WRITE), then written. About 5 under a
+/// hypervisor with shadow page tables, well under 1 with hardware-assisted paging.
+double first_write_microseconds();
+/// From this cost of a 4 KiB page's first write, huge pages pay (main chooses them).
+constexpr double huge_pages_from_microseconds = 2.0;
+
 }  // namespace whitted::large_blocks

@@ -156,6 +156,46 @@ void install_signal_handlers() {
     }
 }
 
+/// What the process uses for its large blocks, for --stats (choose_huge_pages).
+std::string g_page_summary = "4 KiB pages";
+
+/// Huge pages for the blocks of 2 MiB or more and Embree's, where they pay (large_blocks.cpp
+/// says why): WHITTED_HUGE_PAGES=on or off decides; unset or `auto`, the first write to a
+/// 4 KiB page is timed. False, with the message printed, for a value it does not know.
+bool choose_huge_pages() {
+    namespace blocks = large_blocks;
+    const char* setting = std::getenv("WHITTED_HUGE_PAGES");
+    const std::string value = setting && *setting ? setting : "auto";
+    if (value != "auto" && value != "on" && value != "off") {
+        std::fprintf(stderr, "whitted: error: WHITTED_HUGE_PAGES=%s: not one of auto, on, off\n",
+                     api::printable(value).c_str());
+        return false;
+    }
+    bool huge = false;
+    if (value == "off") {
+        g_page_summary = "4 KiB pages (WHITTED_HUGE_PAGES=off)";
+    } else if (!blocks::replaces_operator_new()) {
+        g_page_summary = "4 KiB pages (the sanitizer's allocator)";
+    } else if (!blocks::system_offers_huge_pages()) {
+        g_page_summary = "4 KiB pages (transparent huge pages are 'never' on this system)";
+    } else if (value == "on") {
+        huge = true;
+        g_page_summary = "2 MiB pages for large blocks (WHITTED_HUGE_PAGES=on)";
+    } else {
+        const double microseconds = blocks::first_write_microseconds();
+        huge = microseconds >= blocks::huge_pages_from_microseconds;
+        g_page_summary = fmt::format("{} (a 4 KiB page's first write took {:.2f} us; huge pages from {:.1f})",
+                                     huge ? "2 MiB pages for large blocks" : "4 KiB pages", microseconds,
+                                     blocks::huge_pages_from_microseconds);
+    }
+    if (huge) {
+        prctl(PR_SET_THP_DISABLE, 0, 0, 0, 0);
+        blocks::use_huge_pages(true);
+        api::use_huge_pages(true);
+    }
+    return true;
+}
+
 /// --stats' account of what traces the rays: Embree's BVH, or each ray testing the scene's few
 /// shapes (api::AcceleratorInfo::has_bvh).
 std::string bvh_summary(const api::AcceleratorInfo& accelerator) {
@@ -391,10 +431,10 @@ int run_render(const RenderArguments& args) {
             "whitted: stages: read (parse, validate, load meshes) %.3fs, build BVH %.3fs, render %.3fs, write "
             "%.3fs; "
             "%zu triangles, %zu spheres, %zu boxes, %zu planes, %zu lights, %zu instances (%zu triangles seen); "
-            "%s\n",
+            "%s; memory: %s\n",
             scene.read_seconds(), build_seconds, result.stats.seconds, write_seconds, counts.triangles, counts.spheres,
             counts.boxes, counts.planes, counts.lights, counts.instances, counts.instanced_triangles,
-            bvh_summary(*accelerator).c_str());
+            bvh_summary(*accelerator).c_str(), g_page_summary.c_str());
     if (!args.quiet)
         std::fprintf(
             stderr,
@@ -503,11 +543,12 @@ std::string documentation_root() {
 }  // namespace
 
 int main(int argc, char** argv) {
-    // Transparent huge pages off for this process. Embree asks for them (madvise) for all its
-    // BVH memory. Where a virtual machine's host takes back the guest's free memory in 2 MiB
-    // blocks (virtio-balloon free page reporting), a huge page is exactly such a block and its
-    // first touch costs the host 512 faults: BVH builds ran several times slower, and no scene
-    // rendered faster with them (docs/performance.md, "Design choices and what they cost").
+    // Transparent huge pages off for this process until a command that traces rays finds that
+    // they pay here (choose_huge_pages). Embree asks for them (madvise) for all its BVH memory.
+    // Where a virtual machine's host takes back the guest's free memory in 2 MiB blocks
+    // (virtio-balloon free page reporting), a huge page is exactly such a block and its first
+    // touch costs the host 512 faults: BVH builds ran several times slower (docs/performance.md,
+    // "Design choices and what they cost").
     prctl(PR_SET_THP_DISABLE, 1, 0, 0, 0);
     // Freed blocks under 1 MiB stay in malloc's heaps for the next one (large_blocks.cpp).
     whitted::large_blocks::keep_freed_memory();
@@ -534,6 +575,8 @@ int main(int argc, char** argv) {
         "Environment: OCIO (colour config), WHITTED_POVRAY (POV-Ray for check),\n"
         "WHITTED_EMBREE_ISA=sse2|sse4.2|avx|avx2|avx512 (force Embree's instruction set; the\n"
         "image is the same bit for bit, only the speed differs; --version lists this CPU's).\n"
+        "WHITTED_HUGE_PAGES=auto|on|off (2 MiB pages for large blocks: auto, where a 4 KiB page's\n"
+        "first write is dear; --stats says which; the image is the same either way).\n"
         "Under mpirun or srun, `render` shares the tiles out among the ranks (WHITTED_MPI=0: don't;\n"
         "docs/distributed.md).\n"
         "Scene format: docs/scene-format.md. Examples: examples/lecture/.\n"
@@ -787,8 +830,10 @@ int main(int argc, char** argv) {
 
     // WHITTED_EMBREE_ISA, checked before any work: a name Embree does not know, or an instruction
     // set this CPU lacks, is a usage error, not a failure after parsing and loading.
-    if (*render_cmd || *check_cmd || *explain_cmd || *live_cmd)
+    if (*render_cmd || *check_cmd || *explain_cmd || *live_cmd) {
         if (const auto usable = api::check_embree_isa(); !usable) return report(usable.error());
+        if (!choose_huge_pages()) return exit_bad_input;
+    }
     if (*live_cmd) {
         live_args.open_browser = !live_no_open;
         return run_live(live_args);

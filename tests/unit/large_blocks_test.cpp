@@ -13,11 +13,13 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <memory>
 #include <new>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -194,6 +196,90 @@ TEST(LargeBlocks, BlocksUnderEightMebibytesComeFromTheHeaps) {
     std::free(heap);
     EXPECT_EQ(after_heap, before) << "a block just under the threshold was mapped on its own";
     EXPECT_EQ(after_mapped, before + 1) << "a block of the threshold came from a heap";
+}
+
+/// The VmFlags of the mapping holding `address` (/proc/self/smaps): "hg" where it asked for
+/// huge pages (MADV_HUGEPAGE), "nh" where it refused them.
+std::string mapping_flags(const void* address) {
+    std::FILE* smaps = std::fopen("/proc/self/smaps", "r");
+    if (!smaps) return "";
+    char line[512];
+    bool inside = false;
+    std::string flags;
+    const auto at = uintptr_t(address);
+    while (std::fgets(line, sizeof line, smaps)) {
+        unsigned long start = 0, end = 0;
+        if (std::sscanf(line, "%lx-%lx ", &start, &end) == 2 && std::strchr(line, '-') < std::strchr(line, ' ')) {
+            inside = at >= start && at < end;
+        } else if (inside && std::strncmp(line, "VmFlags:", 8) == 0) {
+            flags = line + 8;
+            break;
+        }
+    }
+    std::fclose(smaps);
+    return flags;
+}
+
+/// Restores use_huge_pages(false) however a test ends.
+struct HugePagesForThisTest {
+    HugePagesForThisTest() { blocks::use_huge_pages(true); }
+    ~HugePagesForThisTest() { blocks::use_huge_pages(false); }
+};
+
+TEST(LargeBlocks, WithHugePagesBlocksFromTwoMebibytesAreAlignedAndAskForThem) {
+    if (!blocks::replaces_operator_new()) GTEST_SKIP() << "the sanitizer's operator new is kept";
+    EXPECT_EQ(blocks::huge_from(), size_t(2) << 20);
+    EXPECT_FALSE(blocks::huge_pages());
+    const HugePagesForThisTest huge;
+    EXPECT_TRUE(blocks::huge_pages());
+    const size_t two = blocks::huge_from();
+    // At the threshold, odd sizes past it, a heap-sized block and one malloc maps on its own.
+    for (const size_t bytes : {two, two + 1, size_t(3) << 20 | 5, blocks::mapped_from() + 12345}) {
+        const std::unique_ptr<char[]> block(new char[bytes]);
+        EXPECT_EQ(uintptr_t(block.get()) % two, 0u) << bytes << " bytes";
+        EXPECT_NE(mapping_flags(block.get()).find(" hg"), std::string::npos) << bytes << " bytes";
+        std::memset(block.get(), 7, bytes);  // the whole block is the caller's
+        EXPECT_EQ(block[bytes - 1], 7);
+    }
+    // Under the threshold, as without huge pages: populated.
+    if (kernel_populates()) {
+        const size_t bytes = two - 4096;
+        const std::unique_ptr<char[]> block(new char[bytes]);
+        size_t pages = 0;
+        const size_t mapped = mapped_pages(block.get(), bytes, pages);
+        EXPECT_EQ(mapped, pages);
+    }
+}
+
+TEST(LargeBlocks, WithHugePagesTheStandardContractHolds) {
+    if (!blocks::replaces_operator_new()) GTEST_SKIP() << "the sanitizer's operator new is kept";
+    const HugePagesForThisTest huge;
+    volatile size_t impossible = std::numeric_limits<size_t>::max() - 4096;  // rounding would wrap
+    EXPECT_THROW((void)::operator new(impossible), std::bad_alloc);
+    EXPECT_EQ(::operator new(impossible, std::nothrow), nullptr);
+    std::vector<float> image(size_t(1280) * 960 * 3, 0.5f);  // grown, copied and freed by the vector
+    image.resize(image.size() * 2, 0.25f);
+    EXPECT_EQ(image.front(), 0.5f);
+    EXPECT_EQ(image.back(), 0.25f);
+}
+
+TEST(LargeBlocks, TheSystemsHugePageSettingIsRead) {
+    std::FILE* file = std::fopen("/sys/kernel/mm/transparent_hugepage/enabled", "r");
+    if (!file) {
+        EXPECT_FALSE(blocks::system_offers_huge_pages());
+        return;
+    }
+    char text[128] = {};
+    text[std::fread(text, 1, sizeof text - 1, file)] = '\0';
+    std::fclose(file);
+    EXPECT_EQ(blocks::system_offers_huge_pages(), std::strstr(text, "[never]") == nullptr) << text;
+}
+
+TEST(LargeBlocks, AFirstWriteIsTimed) {
+    const double microseconds = blocks::first_write_microseconds();
+    EXPECT_GT(microseconds, 0.0);
+    EXPECT_LT(microseconds, 1e5);  // 0.1 s a page: no machine, only a broken clock
+    EXPECT_EQ(blocks::huge_pages_from_microseconds, 2.0);
 }
 
 TEST(LargeBlocks, ZeroBytesGiveDistinctBlocks) {

@@ -391,6 +391,12 @@ WHITTED_API Expected<EmbreeInfo> embree_info();
 /// $WHITTED_EMBREE_ISA, checked before any work: a name Embree does not know, or an instruction
 /// set this CPU lacks, is an Error (bad_input). The image is the same for every one.
 WHITTED_API Expected<void> check_embree_isa();
+/// Whether the large arrays the library maps for Embree (each triangle's widened corners and
+/// their indices) ask for transparent huge pages (MADV_HUGEPAGE, faulted 2 MiB at a time)
+/// instead of being mapped in whole as they are made (MAP_POPULATE). Off unless turned on; the
+/// `whitted` program turns it on where a 4 KiB page's first write is dear (docs/performance.md,
+/// "Huge pages where they pay"). Memory only: the image is the same bit for bit either way.
+WHITTED_API void use_huge_pages(bool on);
 
 /// `text` (a file name or word the user typed) made safe to print in a message: control
 /// characters and bytes that are not UTF-8 as \xNN, at most `max_characters` characters.

@@ -67,6 +67,18 @@ using accel::isa_list;
 using accel::make_device;
 using accel::native_lane_width;
 
+namespace {
+std::atomic<bool> g_huge_pages{false};
+}  // namespace
+
+void use_huge_pages(bool on) {
+    g_huge_pages.store(on, std::memory_order_relaxed);
+}
+
+bool huge_pages_in_use() {
+    return g_huge_pages.load(std::memory_order_relaxed);
+}
+
 const std::vector<std::string>& embree_isa_names() {
     static const std::vector<std::string> names = {"sse2", "sse4.2", "avx", "avx2", "avx512"};
     return names;

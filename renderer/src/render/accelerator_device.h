@@ -29,6 +29,13 @@ std::string embree_isa_from_environment();
 void require_embree_isa(const std::string& isa);
 bool embree_isa_supported(const std::string& isa);
 
+/// Whether the arrays the accelerator maps for Embree (the widened corners, their indices,
+/// MappedArray) ask for transparent huge pages instead of being mapped in whole as they are
+/// made. Off unless the caller turns it on (api::use_huge_pages): the `whitted` program does
+/// where a 4 KiB page's first write is dear (renderer/app/large_blocks.cpp says where).
+void use_huge_pages(bool on);
+bool huge_pages_in_use();
+
 /// What `whitted --version` reports of Embree.
 struct EmbreeInfo {
     std::string version;            ///< e.g. "3.13.5"

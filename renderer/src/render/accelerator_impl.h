@@ -144,8 +144,10 @@ struct TriangleGeometry {
 /// An array for Embree to read (the widened corners, their indices), in anonymous memory that
 /// the kernel maps in whole as it is made (MAP_POPULATE) and zeroes. It is written once, front
 /// to back, right after: touched a page at a time instead, every 4 KiB is a page fault, and on
-/// the virtual machine of docs/performance.md the faults cost more than the writing. Ordinary
-/// pages, not transparent huge ones: see `main` (renderer/app/main.cpp) for why.
+/// the virtual machines of docs/performance.md the faults cost more than the writing. Where the
+/// caller has chosen huge pages (use_huge_pages: where a 4 KiB page's first write traps to the
+/// hypervisor even after the kernel mapped it), it asks for them instead and is left to fault:
+/// one fault per 2 MiB.
 template <class T>
 class MappedArray {
 public:
@@ -153,9 +155,11 @@ public:
     /// `count` elements and `padding` bytes after them (zero, as the whole mapping is).
     MappedArray(size_t count, size_t padding) : m_bytes(count * sizeof(T) + padding) {
         if (m_bytes == 0) return;
-        void* memory =
-            mmap(nullptr, m_bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+        const bool huge = huge_pages_in_use();
+        void* memory = mmap(nullptr, m_bytes, PROT_READ | PROT_WRITE,
+                            MAP_PRIVATE | MAP_ANONYMOUS | (huge ? 0 : MAP_POPULATE), -1, 0);
         if (memory == MAP_FAILED) throw std::bad_alloc();
+        if (huge) madvise(memory, m_bytes, MADV_HUGEPAGE);
         m_data = static_cast<T*>(memory);
     }
     MappedArray(MappedArray&& other) noexcept
