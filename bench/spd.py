@@ -54,12 +54,14 @@ def lights_at_the_eye(path):
     with open(path, "rb") as f:
         for number, line in enumerate(f):
             words = line.split()
+            if not words:
+                continue
             try:
-                if words and words[0] == b"from" and len(words) >= 4:
+                if words[0] == b"from" and len(words) >= 4:
                     eye = [float(w) for w in words[1:4]]
-                elif words and words[0] == b"hither" and len(words) >= 2:
+                elif words[0] == b"hither" and len(words) >= 2:
                     hither = float(words[1])
-                elif words and words[0] == b"l" and len(words) >= 4:
+                elif words[0] == b"l" and len(words) >= 4:
                     lights.append((number, [float(w) for w in words[1:4]]))
             except ValueError:
                 continue  # not a number: Whitted's render of the file says where

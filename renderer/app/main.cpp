@@ -161,16 +161,13 @@ std::string g_page_summary = "4 KiB pages";
 
 /// Huge pages for the blocks of 2 MiB or more and Embree's, where they pay (large_blocks.cpp
 /// says why): WHITTED_HUGE_PAGES=on or off decides; unset or `auto`, the first write to a
-/// 4 KiB page is timed. False, with the message printed, for a value it does not know.
-bool choose_huge_pages() {
+/// 4 KiB page is timed. A value it does not know is an Error (bad input).
+api::Expected<void> choose_huge_pages() {
     namespace blocks = large_blocks;
     const char* setting = std::getenv("WHITTED_HUGE_PAGES");
     const std::string value = setting && *setting ? setting : "auto";
-    if (value != "auto" && value != "on" && value != "off") {
-        std::fprintf(stderr, "whitted: error: WHITTED_HUGE_PAGES=%s: not one of auto, on, off\n",
-                     api::printable(value).c_str());
-        return false;
-    }
+    if (value != "auto" && value != "on" && value != "off")
+        return api::Error{"WHITTED_HUGE_PAGES=" + api::printable(value) + ": not one of auto, on, off"};
     bool huge = false;
     if (value == "off") {
         g_page_summary = "4 KiB pages (WHITTED_HUGE_PAGES=off)";
@@ -193,7 +190,7 @@ bool choose_huge_pages() {
         blocks::use_huge_pages(true);
         api::use_huge_pages(true);
     }
-    return true;
+    return {};
 }
 
 /// --stats' account of what traces the rays: Embree's BVH, or each ray testing the scene's few
@@ -832,7 +829,7 @@ int main(int argc, char** argv) {
     // set this CPU lacks, is a usage error, not a failure after parsing and loading.
     if (*render_cmd || *check_cmd || *explain_cmd || *live_cmd) {
         if (const auto usable = api::check_embree_isa(); !usable) return report(usable.error());
-        if (!choose_huge_pages()) return exit_bad_input;
+        if (const auto chosen = choose_huge_pages(); !chosen) return report(chosen.error());
     }
     if (*live_cmd) {
         live_args.open_browser = !live_no_open;
